@@ -1,0 +1,121 @@
+// sphfsi: the generic particle system, the template every scene is built on.
+//
+//   ParticleSystem<Dim, T, Kernel, Eos>
+//
+// holds the structure-of-arrays particle storage, the scene's domain, the neighbour search and the two
+// compile-time policies every physics model needs: the smoothing kernel and the fluid's equation of state.
+// Physics (fluid, walls, solids, couplings) lives above it in its own headers and only reads and writes the
+// particle arrays; nothing here names a particular physics.
+//
+// Particles of different sizes: pair interactions use the averaged smoothing length h_ab = (h_a + h_b) / 2
+// (Hernquist & Katz 1989, ApJS 70:419; Monaghan 1992, ARA&A 30:543, sec. 6), so W_ab = W_ba and pair forces
+// cancel exactly; the cell size is the largest support radius in the scene.
+#pragma once
+
+#include <sphfsi/core/domain.hpp>
+#include <sphfsi/core/error.hpp>
+#include <sphfsi/core/parallel.hpp>
+#include <sphfsi/core/particle_set.hpp>
+#include <sphfsi/core/types.hpp>
+#include <sphfsi/eos/concepts.hpp>
+#include <sphfsi/kernel/concepts.hpp>
+#include <sphfsi/neighbors/cell_list.hpp>
+
+#include <cmath>
+
+namespace sphfsi {
+
+template <int Dim, Real T, class Kernel, class Eos>
+  requires SpatialDimension<Dim> && SmoothingKernel<Kernel, T> && EquationOfState<Eos, T> &&
+           (Kernel::dimension == Dim)
+class ParticleSystem {
+ public:
+  static constexpr int dimension = Dim;
+  using scalar_type = T;
+  using kernel_type = Kernel;
+  using eos_type = Eos;
+  using Vector = Vec<Dim, T>;
+  using Particles = ParticleSet<Dim, T>;
+
+  ParticleSystem(const Domain<Dim, T>& domain, const Eos& eos, const Kernel& kernel = Kernel{})
+      : domain_(domain), eos_(eos), kernel_(kernel) {}
+
+  Particles& particles() noexcept { return particles_; }
+  const Particles& particles() const noexcept { return particles_; }
+  const Domain<Dim, T>& domain() const noexcept { return domain_; }
+  const Eos& eos() const noexcept { return eos_; }
+  const Kernel& kernel() const noexcept { return kernel_; }
+  std::size_t size() const noexcept { return particles_.size(); }
+
+  /// Throws BlowUpError naming the first particle outside the domain or with a non-finite state.
+  void check_state(T time) const {
+    const auto& p = particles_;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const char* bad = nullptr;
+      if (!p.position[i].allFinite()) bad = "position";
+      else if (!p.velocity[i].allFinite()) bad = "velocity";
+      else if (!std::isfinite(p.density[i]) || !(p.density[i] > T(0))) bad = "density";
+      if (bad)
+        throw BlowUpError(fmt::format("blow-up at t = {:.6g} s: {} particle id {} has a non-finite or non-physical "
+                                      "{} (x = [{}], v = [{}], rho = {})",
+                                      time, kind_name(p.kind[i]), p.id[i], bad, fmt_vec(p.position[i]),
+                                      fmt_vec(p.velocity[i]), p.density[i]));
+      if (!domain_.contains(p.position[i]))
+        throw BlowUpError(fmt::format("at t = {:.6g} s: {} particle id {} left the domain: x = [{}], domain [{}] to [{}]",
+                                      time, kind_name(p.kind[i]), p.id[i], fmt_vec(p.position[i]),
+                                      fmt_vec(domain_.lower), fmt_vec(domain_.upper)));
+    }
+  }
+
+  /// Re-sorts particles by cell and rebuilds the neighbour index. Call after particles moved.
+  void update_neighbors(T time = T(0)) {
+    check_state(time);
+    T h_max = T(0);
+    for (T h : particles_.smoothing_length) h_max = std::max(h_max, h);
+    if (h_max <= T(0)) h_max = T(1);
+    cells_.build(particles_, domain_, static_cast<T>(Kernel::support) * h_max);
+  }
+
+  /// Calls f(j, dx, r, h_ab) for every particle j != i with r = |x_i - x_j| < support * h_ab.
+  template <class F>
+  void for_each_neighbor(std::size_t i, F&& f) const {
+    const Vector xi = particles_.position[i];
+    const T hi = particles_.smoothing_length[i];
+    const T* h = particles_.smoothing_length.data();
+    const Vector* x = particles_.position.data();
+    constexpr T support = static_cast<T>(Kernel::support);
+    cells_.for_each_candidate(i, [&](std::size_t j) {
+      const Vector dx = xi - x[j];
+      const T r2 = dx.squaredNorm();
+      const T h_ab = T(0.5) * (hi + h[j]);
+      const T radius = support * h_ab;
+      if (r2 < radius * radius && j != i) f(j, dx, std::sqrt(r2), h_ab);
+    });
+  }
+
+  /// Recomputes pressure and sound speed of every particle from its density with the fluid EOS.
+  void update_pressure() {
+    auto& p = particles_;
+    parallel_for(p.size(), [&](std::size_t i) {
+      p.pressure[i] = eos_.pressure(p.density[i]);
+      p.sound_speed[i] = eos_.sound_speed(p.density[i]);
+    });
+  }
+
+  const CellList<Dim, T>& cells() const noexcept { return cells_; }
+
+ private:
+  static std::string fmt_vec(const Vector& v) {
+    std::string s;
+    for (int d = 0; d < Dim; ++d) s += (d ? ", " : "") + fmt::format("{:.6g}", v[d]);
+    return s;
+  }
+
+  Domain<Dim, T> domain_;
+  Eos eos_;
+  Kernel kernel_;
+  Particles particles_;
+  CellList<Dim, T> cells_;
+};
+
+}  // namespace sphfsi

@@ -1,0 +1,41 @@
+// sphfsi: basic vocabulary types shared by every module.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+
+namespace sphfsi {
+
+/// Fixed-size spatial vector of dimension Dim (2 or 3) and scalar T (float or double).
+template <int Dim, class T>
+using Vec = Eigen::Matrix<T, Dim, 1>;
+
+/// Fixed-size Dim x Dim tensor (stress, deformation gradient, kernel-gradient correction).
+template <int Dim, class T>
+using Mat = Eigen::Matrix<T, Dim, Dim>;
+
+/// What a particle is. Kinds are data, not types: one storage holds all of them.
+enum class Kind : std::uint8_t {
+  fluid = 0,  ///< weakly-compressible fluid, moves with the flow
+  wall = 1,   ///< boundary particle, fixed or moving with a prescribed motion
+  solid = 2,  ///< elastic solid particle, advanced by a solid model
+};
+
+/// Human-readable name of a particle kind (for diagnostics and output).
+constexpr const char* kind_name(Kind k) noexcept {
+  switch (k) {
+    case Kind::fluid: return "fluid";
+    case Kind::wall: return "wall";
+    case Kind::solid: return "solid";
+  }
+  return "unknown";
+}
+
+/// Dimension and scalar type a scene is built for.
+template <class T>
+concept Real = std::is_same_v<T, float> || std::is_same_v<T, double>;
+
+template <int Dim>
+concept SpatialDimension = (Dim == 2 || Dim == 3);
+
+}  // namespace sphfsi

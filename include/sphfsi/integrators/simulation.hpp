@@ -1,0 +1,181 @@
+// sphfsi: the time loop. A Simulation advances a ParticleSystem with a fluid model, walls (fixed or moving
+// with a prescribed motion), any number of extra ParticleModels (solids, couplings) and a TimeIntegrator.
+// The time step varies with the acoustic CFL, force and viscous conditions (WcsphFluid::stable_time_step)
+// unless a fixed step is given; a fixed step above the stability limit is rejected.
+#pragma once
+
+#include <sphfsi/core/error.hpp>
+#include <sphfsi/core/types.hpp>
+#include <sphfsi/fluid/wcsph.hpp>
+#include <sphfsi/integrators/concepts.hpp>
+
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <map>
+#include <tuple>
+#include <vector>
+
+namespace sphfsi {
+
+template <Real T>
+struct TimeStepParameters {
+  T cfl{T(0.2)};          ///< CFL number applied to the stable step, (0, 1]
+  T fixed_dt{T(0)};       ///< fixed step, s (0: variable step)
+  T max_dt{T(1e-2)};      ///< upper bound of the variable step, s
+  T min_dt{T(1e-10)};     ///< a step below this is a blow-up ("collapsing time step"), s
+
+  void validate() const {
+    require_in_range("TimeStepParameters::cfl", cfl, T(1e-6), T(1));
+    require_non_negative("TimeStepParameters::fixed_dt (s)", fixed_dt);
+    require_positive("TimeStepParameters::max_dt (s)", max_dt);
+    require_positive("TimeStepParameters::min_dt (s)", min_dt);
+  }
+};
+
+/// A prescribed rigid translation of a wall group: displacement(t) from the initial position and velocity(t).
+template <int Dim, Real T>
+struct PrescribedMotion {
+  std::function<Vec<Dim, T>(T)> displacement;
+  std::function<Vec<Dim, T>(T)> velocity;
+};
+
+template <class System, class Integrator, class... Models>
+  requires(ParticleModel<Models, System> && ...)
+class Simulation {
+ public:
+  static constexpr int Dim = System::dimension;
+  using T = typename System::scalar_type;
+  using Vector = Vec<Dim, T>;
+  using scalar_type = T;
+
+  Simulation(System& system, const FluidParameters<Dim, T>& fluid, const TimeStepParameters<T>& time_step = {},
+             Models... models)
+      : system_(system), fluid_(fluid), time_step_(time_step), models_(std::move(models)...) {
+    time_step_.validate();
+  }
+
+  System& system() noexcept { return system_; }
+  const System& system() const noexcept { return system_; }
+  WcsphFluid<System>& fluid() noexcept { return fluid_; }
+  template <std::size_t I>
+  auto& model() noexcept { return std::get<I>(models_); }
+  T time() const noexcept { return time_; }
+  std::size_t step_count() const noexcept { return steps_; }
+  T last_time_step() const noexcept { return dt_; }
+
+  /// Moves all wall particles of `body` rigidly with the given motion (a wavemaker paddle, a piston).
+  void set_wall_motion(std::int32_t body, PrescribedMotion<Dim, T> motion) {
+    if (!motion.displacement || !motion.velocity)
+      throw InputError("set_wall_motion: both displacement(t) and velocity(t) must be given");
+    motions_[body] = std::move(motion);
+    const auto& p = system_.particles();
+    reference_position_.resize(p.size());
+    for (std::size_t i = 0; i < p.size(); ++i) reference_position_[p.id[i]] = p.position[i];
+  }
+
+  /// Advances one time step; returns the step taken.
+  T step() {
+    if (!initialised_) initialise();
+    const T dt = next_time_step();
+    Integrator{}.step(*this, dt);
+    time_ += dt;
+    dt_ = dt;
+    ++steps_;
+    return dt;
+  }
+
+  /// Advances until end_time (the last step is shortened to land on it), calling observer(*this) after each step.
+  template <class Observer>
+  void run(T end_time, Observer&& observer) {
+    require_finite("Simulation::run end_time (s)", end_time);
+    if (!initialised_) initialise();
+    while (time_ < end_time - T(1e-12) * std::max(T(1), end_time)) {
+      end_limit_ = end_time;
+      step();
+      observer(*this);
+    }
+    end_limit_ = std::numeric_limits<T>::max();
+  }
+  void run(T end_time) {
+    run(end_time, [](Simulation&) {});
+  }
+
+  // ---- hooks used by the integrators ----
+
+  /// Neighbours, pressure, fluid and wall rates, then each model's rates, at time t.
+  void evaluate_rates(T t) {
+    system_.update_neighbors(t);
+    system_.update_pressure();
+    fluid_.compute_rates(system_);
+    std::apply([&](auto&... m) { (m.compute_rates(system_, t), ...); }, models_);
+  }
+
+  /// Places moving wall particles at their prescribed position and velocity at time t.
+  void move_walls(T t) {
+    if (motions_.empty()) return;
+    auto& p = system_.particles();
+    for (const auto& [body, motion] : motions_) {
+      const Vector d = motion.displacement(t), v = motion.velocity(t);
+      for (std::size_t i = 0; i < p.size(); ++i) {
+        if (p.kind[i] != Kind::wall || p.body[i] != body) continue;
+        p.position[i] = reference_position_[p.id[i]] + d;
+        p.velocity[i] = v;
+      }
+    }
+  }
+
+  /// Lets every model advance the particles it owns over [t, t + dt].
+  void advance_models(T t, T dt) {
+    std::apply([&](auto&... m) { (m.advance(system_, t, dt), ...); }, models_);
+  }
+
+  /// Density after an update: wall particles never drop below rho0 (no wall suction).
+  T limit_density(std::size_t i, T rho) const {
+    if (system_.particles().kind[i] == Kind::wall) return std::max(rho, system_.eos().reference_density());
+    return rho;
+  }
+
+  /// The step the next call to step() will take.
+  T next_time_step() {
+    if (!initialised_) initialise();
+    T stable = fluid_.stable_time_step(system_);
+    std::apply([&](const auto&... m) { ((stable = std::min(stable, m.stable_time_step(system_))), ...); }, models_);
+    T dt;
+    if (time_step_.fixed_dt > T(0)) {
+      dt = time_step_.fixed_dt;
+      if (dt > stable && steps_ == 0)
+        throw InputError(fmt::format("TimeStepParameters::fixed_dt = {} s is above the stability limit of this "
+                                     "scene (acoustic, force and viscous conditions): valid range is (0, {}] s",
+                                     dt, stable));
+    } else {
+      dt = std::min(time_step_.cfl * stable, time_step_.max_dt);
+    }
+    if (!(dt >= time_step_.min_dt))
+      throw BlowUpError(fmt::format("time step collapsed at t = {:.6g} s, step {}: dt = {:.3g} s is below "
+                                    "min_dt = {:.3g} s (largest acceleration or sound speed exploded)",
+                                    time_, steps_, dt, time_step_.min_dt));
+    if (time_ + dt > end_limit_) dt = std::max(end_limit_ - time_, time_step_.min_dt);
+    return dt;
+  }
+
+ private:
+  void initialise() {
+    initialised_ = true;
+    move_walls(time_);
+    evaluate_rates(time_);
+  }
+
+  System& system_;
+  WcsphFluid<System> fluid_;
+  TimeStepParameters<T> time_step_;
+  std::tuple<Models...> models_;
+  std::map<std::int32_t, PrescribedMotion<Dim, T>> motions_;
+  std::vector<Vector> reference_position_;
+  T time_{0}, dt_{0};
+  T end_limit_ = std::numeric_limits<T>::max();
+  std::size_t steps_{0};
+  bool initialised_{false};
+};
+
+}  // namespace sphfsi

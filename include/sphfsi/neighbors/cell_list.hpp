@@ -1,0 +1,102 @@
+// sphfsi: cell-linked list neighbour search (Hockney & Eastwood 1988; Monaghan & Lattanzio 1985), O(N).
+//
+// The domain is cut into cubic cells of edge >= the largest interaction radius. A counting sort assigns
+// particles to cells; the particle set is then permuted into cell order so that the particles of a cell, and
+// of a row of neighbouring cells, are contiguous in memory. The grid has one empty ghost layer on each side,
+// so the 3^D stencil needs no bounds checks; in the cell-ordered set the three cells of one stencil row form
+// one contiguous particle range (3 ranges per particle in 2D, 9 in 3D).
+#pragma once
+
+#include <sphfsi/core/domain.hpp>
+#include <sphfsi/core/error.hpp>
+#include <sphfsi/core/particle_set.hpp>
+#include <sphfsi/core/types.hpp>
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+namespace sphfsi {
+
+template <int Dim, Real T>
+class CellList {
+ public:
+  using Vector = Vec<Dim, T>;
+
+  /// Sorts `particles` into cells of edge >= cell_size covering `domain` and (re)builds the cell index.
+  /// Particles outside the domain must have been rejected before (see ParticleSystem::check_domain).
+  void build(ParticleSet<Dim, T>& particles, const Domain<Dim, T>& domain, T cell_size) {
+    require_positive("CellList cell_size (m)", cell_size);
+    lower_ = domain.lower;
+    std::size_t total = 1;
+    for (int d = 0; d < Dim; ++d) {
+      const T extent = domain.upper[d] - domain.lower[d];
+      const auto cells = static_cast<std::int64_t>(std::floor(extent / cell_size)) + 1;
+      if (cells > (std::int64_t(1) << 24) || (Dim == 3 && cells > 4096) || (Dim == 2 && cells > 65536))
+        throw InputError(fmt::format("CellList: the domain extent {} m over a cell size of {} m gives {} cells along "
+                                     "axis {}: use a smaller domain or larger particles",
+                                     extent, cell_size, cells, d));
+      cells_[d] = static_cast<std::int32_t>(cells) + 2;  // ghost layer on each side
+      total *= static_cast<std::size_t>(cells_[d]);
+    }
+    inverse_cell_size_ = T(1) / cell_size;
+    cell_size_ = cell_size;
+    const std::size_t n = particles.size();
+    cell_of_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) cell_of_[i] = cell_index(particles.position[i]);
+    // Counting sort by cell: O(N + cells).
+    cell_start_.assign(total + 1, 0);
+    for (std::size_t i = 0; i < n; ++i) ++cell_start_[cell_of_[i] + 1];
+    for (std::size_t c = 0; c < total; ++c) cell_start_[c + 1] += cell_start_[c];
+    order_.resize(n);
+    cursor_.assign(cell_start_.begin(), cell_start_.end() - 1);
+    for (std::size_t i = 0; i < n; ++i) order_[cursor_[cell_of_[i]]++] = static_cast<std::uint32_t>(i);
+    particles.permute(order_);
+    for (std::size_t i = 0; i < n; ++i) cell_of_[i] = cell_index(particles.position[i]);
+  }
+
+  /// Calls f(j) for every particle j in the 3^D cells around particle i's cell (i itself included).
+  template <class F>
+  void for_each_candidate(std::size_t i, F&& f) const {
+    const std::uint32_t c = cell_of_[i];
+    if constexpr (Dim == 2) {
+      const std::int64_t nx = cells_[0];
+      for (std::int64_t dy = -1; dy <= 1; ++dy) {
+        const std::int64_t row = static_cast<std::int64_t>(c) + dy * nx;
+        const std::uint32_t begin = cell_start_[row - 1], end = cell_start_[row + 2];
+        for (std::uint32_t j = begin; j < end; ++j) f(static_cast<std::size_t>(j));
+      }
+    } else {
+      const std::int64_t nx = cells_[0], nxy = std::int64_t(cells_[0]) * cells_[1];
+      for (std::int64_t dz = -1; dz <= 1; ++dz)
+        for (std::int64_t dy = -1; dy <= 1; ++dy) {
+          const std::int64_t row = static_cast<std::int64_t>(c) + dy * nx + dz * nxy;
+          const std::uint32_t begin = cell_start_[row - 1], end = cell_start_[row + 2];
+          for (std::uint32_t j = begin; j < end; ++j) f(static_cast<std::size_t>(j));
+        }
+    }
+  }
+
+  T cell_size() const noexcept { return cell_size_; }
+  std::size_t cell_count() const noexcept { return cell_start_.empty() ? 0 : cell_start_.size() - 1; }
+
+ private:
+  std::uint32_t cell_index(const Vector& x) const {
+    std::int64_t index = 0, stride = 1;
+    for (int d = 0; d < Dim; ++d) {
+      auto c = static_cast<std::int64_t>(std::floor((x[d] - lower_[d]) * inverse_cell_size_)) + 1;
+      c = std::clamp<std::int64_t>(c, 1, cells_[d] - 2);
+      index += c * stride;
+      stride *= cells_[d];
+    }
+    return static_cast<std::uint32_t>(index);
+  }
+
+  Vector lower_ = Vector::Zero();
+  T inverse_cell_size_{1}, cell_size_{1};
+  std::array<std::int32_t, Dim> cells_{};
+  std::vector<std::uint32_t> cell_of_, cell_start_, cursor_, order_;
+};
+
+}  // namespace sphfsi
