@@ -93,10 +93,12 @@ class ParticleSystem {
     });
   }
 
-  /// Recomputes pressure and sound speed of every particle from its density with the fluid EOS.
+  /// Recomputes pressure and sound speed of fluid and wall particles from their density with the fluid EOS.
+  /// Solid particles keep the pressure their solid model wrote.
   void update_pressure() {
     auto& p = particles_;
     parallel_for(p.size(), [&](std::size_t i) {
+      if (p.kind[i] == Kind::solid) return;
       p.pressure[i] = eos_.pressure(p.density[i]);
       p.sound_speed[i] = eos_.sound_speed(p.density[i]);
     });

@@ -18,7 +18,10 @@
 //     pressure and viscosity sums; their density is kept >= rho0 so walls never attract fluid.
 //   repulsive walls (Monaghan & Kos 1999, with Rogers & Dalrymple 2008): see boundary/repulsive_force.hpp;
 //     wall particles only push the fluid along their normal and take no part in the SPH sums.
-// Solid particles are skipped here: a coupling policy owns fluid-solid pairs.
+// Solid particles are skipped here: a coupling policy owns fluid-solid pairs. Contract with the solid models:
+// compute_rates() zeroes the acceleration of solid particles; couplings (ParticleModels evaluated after the
+// fluid) add the fluid-on-solid force per unit mass there; the solid model adds its internal forces and gravity
+// when it advances its particles (possibly in several sub-steps).
 #pragma once
 
 #include <sphfsi/boundary/repulsive_force.hpp>
@@ -97,7 +100,12 @@ class WcsphFluid {
 
     parallel_for(p.size(), [&](std::size_t a) {
       const Kind ka = p.kind[a];
-      if (ka == Kind::solid) return;
+      if (ka == Kind::solid) {  // external (fluid-on-solid) forces start from zero; couplings add to them
+        p.acceleration[a] = Vector::Zero();
+        p.density_rate[a] = T(0);
+        p.xsph_velocity[a] = Vector::Zero();
+        return;
+      }
       Vector acc = Vector::Zero(), xsph = Vector::Zero();
       T drho = T(0), mu_max = T(0);
       const Vector xa = p.position[a], va = p.velocity[a];
