@@ -58,6 +58,7 @@ struct ParticleSet {
     require_positive("particle mass m (kg)", m);
     require_positive("particle smoothing length h (m)", h);
     for (int d = 0; d < Dim; ++d) require_finite("particle position", x[d]);
+    for (int d = 0; d < Dim; ++d) require_finite("particle velocity", v[d]);
     const std::size_t slot = size();
     if (slot >= std::numeric_limits<std::uint32_t>::max())
       throw InputError("particle count exceeds the 32-bit id range");
@@ -106,6 +107,19 @@ struct ParticleSet {
 
   /// Current slot of the particle created with the given id.
   std::size_t slot_of_id(std::uint32_t particle_id) const { return slot_of_id_[particle_id]; }
+
+  /// Rebuilds the id -> slot map from `id`, for arrays filled directly (a checkpoint being read).
+  /// Throws InputError unless `id` is a permutation of 0 .. size() - 1.
+  void rebuild_slot_of_id() {
+    const std::size_t n = id.size();
+    slot_of_id_.assign(n, std::numeric_limits<std::uint32_t>::max());
+    for (std::size_t i = 0; i < n; ++i) {
+      if (id[i] >= n || slot_of_id_[id[i]] != std::numeric_limits<std::uint32_t>::max())
+        throw InputError(fmt::format("ParticleSet: particle id {} in slot {} is out of range or repeated: ids must "
+                                     "be a permutation of 0 .. {}", id[i], i, n - 1));
+      slot_of_id_[id[i]] = static_cast<std::uint32_t>(i);
+    }
+  }
 
   /// Number of particles of a kind.
   std::size_t count(Kind k) const {

@@ -82,6 +82,11 @@ class WcsphFluid {
 
   const FluidParameters<Dim, T>& parameters() const noexcept { return params_; }
 
+  /// Per-slot signal speed max_b |mu_ab| of the last evaluation (part of the time-step state; checkpoints save it).
+  const std::vector<T>& signal_speeds() const noexcept { return signal_speed_; }
+  /// Restores the signal speeds saved with signal_speeds() (io/checkpoint.hpp).
+  void restore_signal_speeds(std::vector<T> speeds) { signal_speed_ = std::move(speeds); }
+
   /// Overwrites acceleration, density_rate and xsph_velocity of fluid and wall particles
   /// (pressure and sound speed must be current: System::update_pressure()).
   void compute_rates(System& system) {

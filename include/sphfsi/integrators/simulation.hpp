@@ -58,8 +58,12 @@ class Simulation {
   System& system() noexcept { return system_; }
   const System& system() const noexcept { return system_; }
   WcsphFluid<System>& fluid() noexcept { return fluid_; }
+  const WcsphFluid<System>& fluid() const noexcept { return fluid_; }
   template <std::size_t I>
   auto& model() noexcept { return std::get<I>(models_); }
+  template <std::size_t I>
+  const auto& model() const noexcept { return std::get<I>(models_); }
+  static constexpr std::size_t model_count = sizeof...(Models);
   T time() const noexcept { return time_; }
   std::size_t step_count() const noexcept { return steps_; }
   T last_time_step() const noexcept { return dt_; }
@@ -99,6 +103,26 @@ class Simulation {
   }
   void run(T end_time) {
     run(end_time, [](Simulation&) {});
+  }
+
+  /// Initial positions of moving wall particles, indexed by particle id (empty without set_wall_motion).
+  const std::vector<Vector>& wall_reference_positions() const noexcept { return reference_position_; }
+
+  /// Resumes from a saved state (io/checkpoint.hpp): the particle arrays, rates included, must already hold the
+  /// state after step `steps`; the first rate evaluation is skipped because the saved rates are those the next
+  /// step would reuse. Wall motions must be registered (set_wall_motion) before this call.
+  void restore_state(T time, std::size_t steps, T last_dt, std::vector<Vector> wall_reference_positions = {}) {
+    require_finite("Simulation::restore_state time (s)", time);
+    require_non_negative("Simulation::restore_state last_dt (s)", last_dt);
+    if (!motions_.empty() && wall_reference_positions.size() != system_.particles().size())
+      throw InputError(fmt::format("Simulation::restore_state wall_reference_positions has {} entries: with moving "
+                                   "walls it needs one per particle ({})",
+                                   wall_reference_positions.size(), system_.particles().size()));
+    time_ = time;
+    steps_ = steps;
+    dt_ = last_dt;
+    reference_position_ = std::move(wall_reference_positions);
+    initialised_ = true;
   }
 
   // ---- hooks used by the integrators ----
