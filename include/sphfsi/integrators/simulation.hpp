@@ -48,6 +48,8 @@ class Simulation {
   using T = typename System::scalar_type;
   using Vector = Vec<Dim, T>;
   using scalar_type = T;
+  using system_type = System;
+  using integrator_type = Integrator;
 
   Simulation(System& system, const FluidParameters<Dim, T>& fluid, const TimeStepParameters<T>& time_step = {},
              Models... models)
