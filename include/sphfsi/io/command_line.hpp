@@ -1,0 +1,78 @@
+// sphfsi: a tiny command-line parser for the example drivers: `--name value` flags with defaults and help text.
+#pragma once
+
+#include <sphfsi/core/error.hpp>
+
+#include <fmt/format.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace sphfsi::io {
+
+class CommandLine {
+ public:
+  /// description: one paragraph printed by --help.
+  CommandLine(int argc, char** argv, std::string description) : description_(std::move(description)) {
+    for (int i = 1; i < argc; ++i) args_.emplace_back(argv[i]);
+  }
+
+  /// Registers a flag and returns its value (or the default). Call for every flag before finish().
+  std::string get(std::string_view name, std::string_view default_value, std::string_view help) {
+    flags_.push_back({std::string(name), std::string(default_value), std::string(help)});
+    for (std::size_t i = 0; i < args_.size(); ++i) {
+      if (args_[i] == fmt::format("--{}", name)) {
+        if (i + 1 >= args_.size()) throw InputError(fmt::format("--{} needs a value", name));
+        used_.push_back(i);
+        used_.push_back(i + 1);
+        return args_[i + 1];
+      }
+    }
+    return std::string(default_value);
+  }
+
+  double get_number(std::string_view name, double default_value, std::string_view help) {
+    const std::string s = get(name, fmt::format("{}", default_value), help);
+    char* end = nullptr;
+    const double v = std::strtod(s.c_str(), &end);
+    if (end == s.c_str() || *end != '\0')
+      throw InputError(fmt::format("--{} = '{}' is not a number", name, s));
+    return v;
+  }
+
+  /// Returns false (after printing the help) if --help was given; throws on unknown flags.
+  bool finish() {
+    for (std::size_t i = 0; i < args_.size(); ++i) {
+      if (args_[i] == "--help" || args_[i] == "-h") {
+        print_help();
+        return false;
+      }
+    }
+    for (std::size_t i = 0; i < args_.size(); ++i) {
+      bool known = false;
+      for (std::size_t u : used_) known = known || u == i;
+      if (!known) throw InputError(fmt::format("unknown argument '{}' (see --help)", args_[i]));
+    }
+    return true;
+  }
+
+  void print_help() const {
+    fmt::print("{}\n\nOptions:\n", description_);
+    for (const auto& f : flags_) fmt::print("  --{:<14} {} (default: {})\n", f.name, f.help, f.default_value);
+    fmt::print("  --help           print this help\n");
+  }
+
+ private:
+  struct Flag {
+    std::string name, default_value, help;
+  };
+  std::string description_;
+  std::vector<std::string> args_;
+  std::vector<Flag> flags_;
+  std::vector<std::size_t> used_;
+};
+
+}  // namespace sphfsi::io
