@@ -110,10 +110,14 @@ class Simulation {
   /// Initial positions of moving wall particles, indexed by particle id (empty without set_wall_motion).
   const std::vector<Vector>& wall_reference_positions() const noexcept { return reference_position_; }
 
+  /// Whether the initial rate evaluation has been done (the first step() or run() does it).
+  bool rates_evaluated() const noexcept { return initialised_; }
+
   /// Resumes from a saved state (io/checkpoint.hpp): the particle arrays, rates included, must already hold the
-  /// state after step `steps`; the first rate evaluation is skipped because the saved rates are those the next
-  /// step would reuse. Wall motions must be registered (set_wall_motion) before this call.
-  void restore_state(T time, std::size_t steps, T last_dt, std::vector<Vector> wall_reference_positions = {}) {
+  /// state after step `steps`; with rates_evaluated the first rate evaluation is skipped because the saved rates
+  /// are those the next step would reuse. Wall motions must be registered (set_wall_motion) before this call.
+  void restore_state(T time, std::size_t steps, T last_dt, std::vector<Vector> wall_reference_positions = {},
+                     bool rates_evaluated = true) {
     require_finite("Simulation::restore_state time (s)", time);
     require_non_negative("Simulation::restore_state last_dt (s)", last_dt);
     if (!motions_.empty() && wall_reference_positions.size() != system_.particles().size())
@@ -124,7 +128,7 @@ class Simulation {
     steps_ = steps;
     dt_ = last_dt;
     reference_position_ = std::move(wall_reference_positions);
-    initialised_ = true;
+    initialised_ = rates_evaluated;
   }
 
   // ---- hooks used by the integrators ----
