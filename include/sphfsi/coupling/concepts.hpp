@@ -1,0 +1,25 @@
+// sphfsi: the FsiCoupling concept, the extension point for fluid-structure coupling.
+//
+// A coupling is a small trivially copyable struct of parameters with
+//   template <class System, class Solid> void apply(System&, const Solid&, T time) const;
+// called after the fluid rates are computed (WcsphFluid skips fluid-solid pairs and zeroes the acceleration of
+// solid particles). It adds the fluid-on-solid force per unit mass to the acceleration of the solid's particles and
+// the equal and opposite reaction to the fluid particles (and, if it treats solid particles as part of the fluid's
+// continuity equation, their contribution to density_rate). Every coupling of sphfsi conserves the linear momentum
+// of the fluid-solid pair to round-off: the reaction is computed from the same pair terms as the action.
+// CoupledBody<Coupling, Solid> (coupling/coupled_body.hpp) turns a coupling and a SolidModel into one ParticleModel.
+#pragma once
+
+#include <concepts>
+#include <type_traits>
+
+namespace sphfsi {
+
+template <class C, class System, class Solid>
+concept FsiCoupling = std::is_trivially_copyable_v<C> &&
+                      requires(const C& c, System& s, const Solid& solid, typename System::scalar_type t) {
+                        { C::name } -> std::convertible_to<const char*>;
+                        { c.apply(s, solid, t) };
+                      };
+
+}  // namespace sphfsi

@@ -1,0 +1,52 @@
+// sphfsi: a solid body coupled to the fluid: one ParticleModel made of an FsiCoupling policy and a SolidModel.
+//
+//   using Gate = CoupledBody<RepulsiveForce<double>, TotalLagrangianSolid<System>>;
+//   Simulation<System, SymplecticVerlet, Gate> sim(system, fluid, time_step, Gate{coupling, solid});
+//
+// Each evaluation: the solid publishes its pressure/stress, then the coupling adds the fluid-on-solid force to
+// the solid's particles and the reaction to the fluid. advance() lets the solid sub-cycle over the fluid step.
+#pragma once
+
+#include <sphfsi/coupling/concepts.hpp>
+#include <sphfsi/solid/concepts.hpp>
+
+#include <algorithm>
+#include <utility>
+
+namespace sphfsi {
+
+template <class Coupling, class Solid>
+class CoupledBody {
+ public:
+  CoupledBody(const Coupling& coupling, Solid solid) : coupling_(coupling), solid_(std::move(solid)) {
+    coupling_.validate();
+  }
+
+  template <class System>
+  void compute_rates(System& system, typename System::scalar_type time) {
+    static_assert(FsiCoupling<Coupling, System, Solid>, "Coupling does not model FsiCoupling (coupling/concepts.hpp)");
+    static_assert(SolidModel<Solid, System>, "Solid does not model SolidModel (solid/concepts.hpp)");
+    solid_.compute_rates(system, time);
+    coupling_.apply(system, solid_, time);
+  }
+
+  template <class System>
+  typename System::scalar_type stable_time_step(const System& system) const {
+    return solid_.stable_time_step(system);
+  }
+
+  template <class System>
+  void advance(System& system, typename System::scalar_type time, typename System::scalar_type dt) {
+    solid_.advance(system, time, dt);
+  }
+
+  Solid& solid() noexcept { return solid_; }
+  const Solid& solid() const noexcept { return solid_; }
+  const Coupling& coupling() const noexcept { return coupling_; }
+
+ private:
+  Coupling coupling_;
+  Solid solid_;
+};
+
+}  // namespace sphfsi

@@ -1,0 +1,61 @@
+// sphfsi: coupling approach 3 of the reference paper (eqs 17-23): repulsive force.
+//
+// The surface particles of the solid (outward normals from solid_surface.hpp, eqs 5-7) act as Monaghan & Kos (1999)
+// boundary particles for the fluid, with the Rogers & Dalrymple (2008) repulsion R, the tangential weight P and the
+// depth/velocity factor eps (boundary/repulsive_force.hpp). The fluid particle f receives the acceleration
+// a_f = n R P eps (17); the solid particle s receives the reaction -m_f a_f / m_s, so the pair conserves momentum to
+// round-off. The paper retains this approach for the Antoci gate and the Posidonia meadow.
+#pragma once
+
+#include <sphfsi/boundary/repulsive_force.hpp>
+#include <sphfsi/core/error.hpp>
+#include <sphfsi/core/types.hpp>
+#include <sphfsi/coupling/solid_surface.hpp>
+
+#include <vector>
+
+namespace sphfsi {
+
+template <Real T>
+struct RepulsiveForce {
+  static constexpr const char* name = "repulsive-force";
+  T water_level{0};   ///< still-water level z0 for eps(z), m
+  T local_depth{0};   ///< h0 of eq. 22; <= 0: eps(z) = 1 (no depth scaling), m
+  T sound_speed{0};   ///< c0 used in A = 0.01 c0^2 / h (19) and eps(u) (23); 0: the fluid EOS's c0, m/s
+  T range_factor{1};  ///< scales the boundary spacing db used in P(xi) (eq. 20), [0.5, 3]
+
+  void validate() const {
+    require_non_negative("RepulsiveForce::sound_speed (m/s)", sound_speed);
+    require_in_range("RepulsiveForce::range_factor", range_factor, T(0.5), T(3));
+  }
+
+  template <class System, class Solid>
+  void apply(System& system, const Solid& solid, T /*time*/) const {
+    using Vector = Vec<System::dimension, T>;
+    constexpr int up = System::dimension - 1;
+    auto& p = system.particles();
+    const auto& ids = solid.particle_ids();
+    std::vector<char> surface;
+    update_solid_surface(system, ids, solid.body(), surface);
+    RepulsiveForceParameters<T> params;
+    params.boundary_spacing = range_factor * solid.reference_spacing();
+    params.water_level = water_level;
+    params.local_depth = local_depth;
+    params.vertical_axis = up;
+    const T c0 = sound_speed > T(0) ? sound_speed : system.eos().reference_sound_speed();
+    for (std::size_t k = 0; k < ids.size(); ++k) {
+      if (!surface[k]) continue;
+      const std::size_t s = p.slot_of_id(ids[k]);
+      const Vector n = p.normal[s];
+      system.for_each_neighbor(s, [&](std::size_t f, const Vector& dx_sf, T, T h) {
+        if (p.kind[f] != Kind::fluid) return;
+        const Vector a_f = repulsive_force<System::dimension, T>(-dx_sf, p.velocity[f] - p.velocity[s], n, h, c0,
+                                                                 p.position[f][up] - water_level, params);
+        p.acceleration[f] += a_f;
+        p.acceleration[s] -= (p.mass[f] / p.mass[s]) * a_f;
+      });
+    }
+  }
+};
+
+}  // namespace sphfsi
