@@ -8,6 +8,7 @@
 #include <sphfsi/core/types.hpp>
 #include <sphfsi/kernel/concepts.hpp>
 
+#include <algorithm>
 #include <numbers>
 
 namespace sphfsi {

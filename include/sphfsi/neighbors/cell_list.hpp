@@ -12,9 +12,11 @@
 #include <sphfsi/core/particle_set.hpp>
 #include <sphfsi/core/types.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace sphfsi {
@@ -25,7 +27,7 @@ class CellList {
   using Vector = Vec<Dim, T>;
 
   /// Sorts `particles` into cells of edge >= cell_size covering `domain` and (re)builds the cell index.
-  /// Particles outside the domain must have been rejected before (see ParticleSystem::check_domain).
+  /// Particles outside the domain must have been rejected before (see ParticleSystem::check_state).
   void build(ParticleSet<Dim, T>& particles, const Domain<Dim, T>& domain, T cell_size) {
     require_positive("CellList cell_size (m)", cell_size);
     lower_ = domain.lower;
@@ -40,6 +42,12 @@ class CellList {
       cells_[d] = static_cast<std::int32_t>(cells) + 2;  // ghost layer on each side
       total *= static_cast<std::size_t>(cells_[d]);
     }
+    // Cell indices are 32-bit (cell_of_): a 3D grid within the per-axis limit can still overflow them.
+    if (total > std::numeric_limits<std::uint32_t>::max() - 1)
+      throw InputError(fmt::format("CellList: the domain over a cell size of {} m needs {} cells (ghost layers "
+                                   "included), more than the 32-bit cell index allows ({}): use a smaller domain or "
+                                   "larger particles",
+                                   cell_size, total, std::numeric_limits<std::uint32_t>::max() - 1));
     inverse_cell_size_ = T(1) / cell_size;
     cell_size_ = cell_size;
     const std::size_t n = particles.size();
