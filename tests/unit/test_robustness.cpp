@@ -1,9 +1,9 @@
 // Robustness (issue 7): input validation of the public API, checkpoint / restart, blow-up handling, progress
 // output, exact mass conservation and the energy bound of a closed tank.
-#include <sphfsi/sphfsi.hpp>
 #include <sphfsi/io/checkpoint.hpp>
 #include <sphfsi/io/guarded_run.hpp>
 #include <sphfsi/io/progress.hpp>
+#include <sphfsi/sphfsi.hpp>
 
 #include <catch2/catch.hpp>
 
@@ -38,9 +38,9 @@ fs::path output_dir() {
 
 // A small 2D dam break in a closed tank: 12 x 12 fluid particles (dp = 1 cm) in a 0.4 m x 0.3 m tank with three
 // layers of dynamic wall particles. c0 = 15 m/s is over ten times the largest flow speed sqrt(2 g H) = 1.5 m/s.
-constexpr T dp = 0.01;          // m
-constexpr T column = 0.12;      // m, width and height of the water column
-constexpr T c0 = 15;            // m/s
+constexpr T dp = 0.01;      // m
+constexpr T column = 0.12;  // m, width and height of the water column
+constexpr T c0 = 15;        // m/s
 const Domain<2, T> tank_domain(V2(-0.06, -0.05), V2(0.46, 0.5));
 const Tait<T> water(1000, c0);
 
@@ -130,8 +130,7 @@ TEST_CASE("Robustness: every bad input of the public API is rejected, naming the
       t.validate();
     };
   };
-  for (T v : {T(0), T(1.5), nan_value})
-    bad.expect("TimeStepParameters::cfl", steps_with([=](auto& t) { t.cfl = v; }));
+  for (T v : {T(0), T(1.5), nan_value}) bad.expect("TimeStepParameters::cfl", steps_with([=](auto& t) { t.cfl = v; }));
   for (T v : {T(-1e-4), nan_value})
     bad.expect("TimeStepParameters::fixed_dt", steps_with([=](auto& t) { t.fixed_dt = v; }));
   for (T v : {T(0), T(-1), inf_value}) {
@@ -519,8 +518,8 @@ TEST_CASE("Robustness: a blow-up stops the run with a diagnosis and keeps the la
     const std::uint32_t thrown = fluid_count - 1;  // top right of the column
     s.particles().velocity[s.particles().slot_of_id(thrown)] = V2(0, 60);
     Sim sim(s, {});
-    const io::GuardedRunOptions options{.checkpoint = checkpoint, .checkpoint_interval = 1e-3,
-                                        .snapshot_interval = 2e-3};
+    const io::GuardedRunOptions options{
+        .checkpoint = checkpoint, .checkpoint_interval = 1e-3, .snapshot_interval = 2e-3};
     const io::GuardedRunResult result = io::guarded_run(sim, 0.5, options, count_snapshot);
     REQUIRE_FALSE(result.completed);
     INFO(result.error);
@@ -597,10 +596,9 @@ TEST_CASE("Robustness: a guarded run without blow-up completes and its final che
   build_dam_break(s);
   Sim sim(s, {});
   std::vector<double> snapshot_times;
-  const io::GuardedRunOptions options{.checkpoint = checkpoint, .checkpoint_interval = 4e-3,
-                                      .snapshot_interval = 5e-3};
-  const auto result = io::guarded_run(sim, 0.02, options,
-                                      [&](const Sim& x, std::size_t) { snapshot_times.push_back(x.time()); });
+  const io::GuardedRunOptions options{.checkpoint = checkpoint, .checkpoint_interval = 4e-3, .snapshot_interval = 5e-3};
+  const auto result =
+      io::guarded_run(sim, 0.02, options, [&](const Sim& x, std::size_t) { snapshot_times.push_back(x.time()); });
   REQUIRE(result.completed);
   CHECK(result.error.empty());
   CHECK(result.time == Approx(0.02).epsilon(1e-12));
@@ -620,11 +618,16 @@ TEST_CASE("Robustness: progress lines report time, step, particles, throughput a
   CHECK(io::format_duration(372) == "6m 12s");
   CHECK(io::format_duration(3723) == "1h 02m 03s");
   CHECK(io::format_duration(-1) == "?");
-  const std::string line = io::format_progress_line(
-      {.time = 0.5, .end_time = 2, .step = 1000, .particles = 480, .steps_per_second = 250,
-       .particle_steps_per_second = 1.2e5, .eta_seconds = 90});
-  CHECK(line == "t = 0.5 / 2 s (25.0%) | step 1000 | 480 particles | 250 steps/s | 1.2e+05 particle-steps/s | "
-                "ETA 1m 30s");
+  const std::string line = io::format_progress_line({.time = 0.5,
+                                                     .end_time = 2,
+                                                     .step = 1000,
+                                                     .particles = 480,
+                                                     .steps_per_second = 250,
+                                                     .particle_steps_per_second = 1.2e5,
+                                                     .eta_seconds = 90});
+  CHECK(line ==
+        "t = 0.5 / 2 s (25.0%) | step 1000 | 480 particles | 250 steps/s | 1.2e+05 particle-steps/s | "
+        "ETA 1m 30s");
 
   for (const auto mode : {io::ProgressMode::lines, io::ProgressMode::in_place}) {
     std::FILE* out = std::tmpfile();
@@ -669,8 +672,7 @@ T total_energy(const System2& system) {
   const auto& p = system.particles();
   T e = 0;
   for (std::size_t i = 0; i < p.size(); ++i) {
-    if (p.kind[i] == Kind::fluid)
-      e += p.mass[i] * (T(0.5) * p.velocity[i].squaredNorm() + T(9.81) * p.position[i][1]);
+    if (p.kind[i] == Kind::fluid) e += p.mass[i] * (T(0.5) * p.velocity[i].squaredNorm() + T(9.81) * p.position[i][1]);
     e += p.mass[i] * tait_internal_energy(system.eos(), p.density[i]);
   }
   return e;

@@ -17,7 +17,8 @@
 // InputError that says what is wrong.
 //
 // Models with state of their own take part when they provide
-//   template <class Writer> void save_checkpoint(Writer&) const;  template <class Reader> void load_checkpoint(Reader&);
+//   template <class Writer> void save_checkpoint(Writer&) const;  template <class Reader> void
+//   load_checkpoint(Reader&);
 // using CheckpointWriter::write / CheckpointReader::read; models without them are taken to be stateless.
 #pragma once
 
@@ -68,7 +69,11 @@ inline std::uint64_t fnv1a(const char* data, std::size_t n, std::uint64_t hash =
 }
 
 template <class V>
-concept FixedEigenVector = requires { typename V::Scalar; V::SizeAtCompileTime; } && (V::SizeAtCompileTime > 0);
+concept FixedEigenVector = requires {
+  typename V::Scalar;
+  V::SizeAtCompileTime;
+}
+&&(V::SizeAtCompileTime > 0);
 
 /// Bytes one element of V occupies in a checkpoint.
 template <class V>
@@ -98,13 +103,9 @@ class CheckpointWriter {
 
   template <class V>
     requires detail::storable<V>
-  void write(std::string_view name, const V& value) {
-    write(name, std::vector<V>{value});
-  }
+  void write(std::string_view name, const V& value) { write(name, std::vector<V>{value}); }
 
-  void write(std::string_view name, std::string_view text) {
-    write(name, std::vector<char>(text.begin(), text.end()));
-  }
+  void write(std::string_view name, std::string_view text) { write(name, std::vector<char>(text.begin(), text.end())); }
 
   const std::vector<char>& bytes() const noexcept { return bytes_; }
 
@@ -295,13 +296,20 @@ inline CheckpointInfo check_file(const std::vector<char>& bytes, const std::stri
   return info;
 }
 
+/// The integrator's name (TimeIntegrator::name), or "unnamed" for one without.
+template <class Integrator>
+std::string integrator_name() {
+  if constexpr (requires { Integrator::name; }) return std::string(Integrator::name);
+  else return "unnamed";
+}
+
 template <class Sim>
 std::vector<typename Sim::scalar_type> fluid_parameter_list(const Sim& sim) {
   using T = typename Sim::scalar_type;
   const auto& f = sim.fluid().parameters();
-  std::vector<T> v{f.artificial_viscosity, f.density_diffusion, f.xsph, f.kinematic_viscosity,
-                   T(static_cast<int>(f.walls)), f.repulsive.boundary_spacing, f.repulsive.water_level,
-                   f.repulsive.local_depth, T(f.repulsive.vertical_axis)};
+  std::vector<T> v{f.artificial_viscosity,  f.density_diffusion,          f.xsph,
+                   f.kinematic_viscosity,   T(static_cast<int>(f.walls)), f.repulsive.boundary_spacing,
+                   f.repulsive.water_level, f.repulsive.local_depth,      T(f.repulsive.vertical_axis)};
   for (int d = 0; d < Sim::Dim; ++d) v.push_back(f.gravity[d]);
   return v;
 }
@@ -322,7 +330,7 @@ void write_checkpoint(const std::filesystem::path& path, const Sim& sim) {
   CheckpointWriter w;
   w.write("simulation.last_dt", sim.last_time_step());
   w.write("simulation.rates_evaluated", static_cast<std::uint8_t>(sim.rates_evaluated() ? 1 : 0));
-  w.write("simulation.integrator", std::string_view(Sim::integrator_type::name));
+  w.write("simulation.integrator", detail::integrator_name<typename Sim::integrator_type>());
   w.write("system.domain.lower", sim.system().domain().lower);
   w.write("system.domain.upper", sim.system().domain().upper);
   w.write("system.eos.reference_density", sim.system().eos().reference_density());
@@ -363,7 +371,8 @@ void write_checkpoint(const std::filesystem::path& path, const Sim& sim) {
           if constexpr (detail::CheckpointableModel<Model>) model.save_checkpoint(w);
         }(),
         ...);
-  }(std::make_index_sequence<Sim::model_count>{});
+  }
+  (std::make_index_sequence<Sim::model_count>{});
 
   std::vector<char> bytes;
   bytes.reserve(detail::header_bytes + w.bytes().size() + detail::trailer_bytes);
@@ -395,8 +404,8 @@ void read_checkpoint(const std::filesystem::path& path, Sim& sim) {
   const std::string source = path.string();
   const std::vector<char> bytes = detail::read_file(path);
   const CheckpointInfo info = detail::check_file(bytes, source);
-  CheckpointReader r(bytes.data() + detail::header_bytes,
-                     bytes.size() - detail::header_bytes - detail::trailer_bytes, source);
+  CheckpointReader r(bytes.data() + detail::header_bytes, bytes.size() - detail::header_bytes - detail::trailer_bytes,
+                     source);
   if (info.dimension != static_cast<std::uint32_t>(Dim))
     r.fail(fmt::format("dimension = {}, this simulation is {}D", info.dimension, Dim));
   if (info.scalar_bytes != sizeof(T))
@@ -412,7 +421,8 @@ void read_checkpoint(const std::filesystem::path& path, Sim& sim) {
   r.read("simulation.last_dt", last_dt);
   std::uint8_t rates_evaluated = 0;
   r.read("simulation.rates_evaluated", rates_evaluated);
-  require_same("integrator", r.read_text("simulation.integrator"), std::string(Sim::integrator_type::name));
+  require_same("integrator", r.read_text("simulation.integrator"),
+               detail::integrator_name<typename Sim::integrator_type>());
   Vector lower, upper;
   r.read("system.domain.lower", lower);
   r.read("system.domain.upper", upper);
@@ -481,12 +491,13 @@ void read_checkpoint(const std::filesystem::path& path, Sim& sim) {
           std::uint8_t has_state = 0;
           r.read(fmt::format("model.{}.has_state", I), has_state);
           if (has_state != (detail::CheckpointableModel<Model> ? 1 : 0))
-            r.fail(fmt::format("model {} {} state in the file but its type {} one", I,
-                               has_state ? "has" : "has no", has_state ? "does not save" : "saves"));
+            r.fail(fmt::format("model {} {} state in the file but its type {} one", I, has_state ? "has" : "has no",
+                               has_state ? "does not save" : "saves"));
           if constexpr (detail::CheckpointableModel<Model>) model.load_checkpoint(r);
         }(),
         ...);
-  }(std::make_index_sequence<Sim::model_count>{});
+  }
+  (std::make_index_sequence<Sim::model_count>{});
   if (!r.at_end()) r.fail("unexpected bytes after the last field");
 
   // Commit: swap the new state in; if the simulation refuses it (moving walls registered that the file does

@@ -28,9 +28,9 @@ namespace sphfsi::io {
 struct GuardedRunOptions {
   std::filesystem::path checkpoint{};  ///< where the last good checkpoint is kept (required)
   std::filesystem::path diagnosis{};   ///< written on blow-up; empty: "<checkpoint>.diagnosis.txt"
-  double checkpoint_interval{0};     ///< simulated seconds between checkpoints, (0, inf)
-  double snapshot_interval{0};       ///< simulated seconds between snapshots, [0, inf) (0: start and end only)
-  bool rethrow{false};               ///< rethrow the BlowUpError (with the diagnosis) instead of returning
+  double checkpoint_interval{0};       ///< simulated seconds between checkpoints, (0, inf)
+  double snapshot_interval{0};         ///< simulated seconds between snapshots, [0, inf) (0: start and end only)
+  bool rethrow{false};                 ///< rethrow the BlowUpError (with the diagnosis) instead of returning
 
   void validate() const {
     if (checkpoint.empty()) throw InputError("GuardedRunOptions::checkpoint = \"\" is invalid: give a file path");
@@ -44,16 +44,16 @@ struct GuardedRunOptions {
 
 /// How a guarded run ended.
 struct GuardedRunResult {
-  bool completed{false};                  ///< reached the end time
-  double time{0};                         ///< simulated time reached, s
-  std::size_t steps{0};                   ///< step count reached
+  bool completed{false};  ///< reached the end time
+  double time{0};         ///< simulated time reached, s
+  std::size_t steps{0};   ///< step count reached
   std::size_t checkpoints_written{0};
   std::size_t snapshots_written{0};
-  double last_checkpoint_time{-1};        ///< s (negative: none written)
+  double last_checkpoint_time{-1};  ///< s (negative: none written)
   std::size_t last_checkpoint_step{0};
-  std::string error;                      ///< the BlowUpError message (empty if completed)
-  std::string diagnosis;                  ///< the diagnosis text (empty if completed)
-  std::filesystem::path diagnosis_file;   ///< where it was written (empty if completed)
+  std::string error;                     ///< the BlowUpError message (empty if completed)
+  std::string diagnosis;                 ///< the diagnosis text (empty if completed)
+  std::filesystem::path diagnosis_file;  ///< where it was written (empty if completed)
 };
 
 /// A text summary of the extremes of a particle state: where a blow-up is to be looked for.
@@ -68,8 +68,8 @@ std::string diagnose_state(const System& system) {
   };
   const auto describe = [&](std::size_t i) {
     return fmt::format("{} particle id {} at x = {} (v = {}, a = {}, rho = {:.6g} kg/m^3, p = {:.6g} Pa)",
-                       kind_name(p.kind[i]), p.id[i], vec(p.position[i]), vec(p.velocity[i]),
-                       vec(p.acceleration[i]), p.density[i], p.pressure[i]);
+                       kind_name(p.kind[i]), p.id[i], vec(p.position[i]), vec(p.velocity[i]), vec(p.acceleration[i]),
+                       p.density[i], p.pressure[i]);
   };
   std::size_t non_finite = 0, outside = 0;
   std::string first_non_finite, first_outside;
@@ -151,16 +151,14 @@ GuardedRunResult guarded_run(Sim& sim, double end_time, const GuardedRunOptions&
     result.completed = true;
   } catch (const BlowUpError& e) {
     result.error = e.what();
-    result.diagnosis =
-        fmt::format("sphfsi blow-up diagnosis\nerror: {}\nlast completed step: t = {:.9g} s, step {}, dt = {:.6g} s\n",
-                    e.what(), static_cast<double>(sim.time()), sim.step_count(),
-                    static_cast<double>(sim.last_time_step()));
+    result.diagnosis = fmt::format(
+        "sphfsi blow-up diagnosis\nerror: {}\nlast completed step: t = {:.9g} s, step {}, dt = {:.6g} s\n", e.what(),
+        static_cast<double>(sim.time()), sim.step_count(), static_cast<double>(sim.last_time_step()));
     if (result.checkpoints_written > 0)
-      result.diagnosis += fmt::format("last good checkpoint: {} (t = {:.9g} s, step {}); resume with read_checkpoint\n",
-                                      options.checkpoint.string(), result.last_checkpoint_time,
-                                      result.last_checkpoint_step);
-    else
-      result.diagnosis += "last good checkpoint: none (the initial state was already bad)\n";
+      result.diagnosis +=
+          fmt::format("last good checkpoint: {} (t = {:.9g} s, step {}); resume with read_checkpoint\n",
+                      options.checkpoint.string(), result.last_checkpoint_time, result.last_checkpoint_step);
+    else result.diagnosis += "last good checkpoint: none (the initial state was already bad)\n";
     result.diagnosis += fmt::format("snapshots written: {}\nstate at failure:\n{}", result.snapshots_written,
                                     diagnose_state(sim.system()));
     result.diagnosis_file = options.diagnosis_path();

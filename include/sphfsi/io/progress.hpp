@@ -48,10 +48,11 @@ inline std::string format_duration(double seconds) {
 /// The progress line for one sample (no line ending).
 inline std::string format_progress_line(const ProgressSample& s) {
   const double fraction = s.end_time > 0 ? 100.0 * s.time / s.end_time : 0.0;
-  return fmt::format("t = {:.4g} / {:.4g} s ({:.1f}%) | step {} | {} particles | {:.3g} steps/s | "
-                     "{:.3g} particle-steps/s | ETA {}",
-                     s.time, s.end_time, fraction, s.step, s.particles, s.steps_per_second,
-                     s.particle_steps_per_second, format_duration(s.eta_seconds));
+  return fmt::format(
+      "t = {:.4g} / {:.4g} s ({:.1f}%) | step {} | {} particles | {:.3g} steps/s | "
+      "{:.3g} particle-steps/s | ETA {}",
+      s.time, s.end_time, fraction, s.step, s.particles, s.steps_per_second, s.particle_steps_per_second,
+      format_duration(s.eta_seconds));
 }
 
 /// How progress is written.
@@ -65,7 +66,7 @@ struct ProgressOptions {
   double interval_s{10.0};          ///< wall seconds between lines in a log, [0, inf)
   double terminal_interval_s{0.2};  ///< wall seconds between in-place updates on a terminal, [0, inf)
   ProgressMode mode{ProgressMode::automatic};
-  std::FILE* stream{stderr};        ///< where progress goes
+  std::FILE* stream{stderr};  ///< where progress goes
 };
 
 /// Observer for Simulation::run printing progress; call finish(sim) after the run for the final line.
