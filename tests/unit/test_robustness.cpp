@@ -381,6 +381,70 @@ TEMPLATE_TEST_CASE("Robustness: a run resumed from a checkpoint is bit-identical
   }
 }
 
+// An extra ParticleModel with state: a horizontal shaking of the fluid whose phase advances with the steps
+// (phase += omega dt), so a restart that dropped the phase would shake differently.
+struct Shaker {
+  T amplitude = 2;  // m/s^2
+  T omega = 40;     // rad/s
+  T phase = 0;      // rad, the state
+
+  void compute_rates(System2& system, T /*time*/) {
+    auto& p = system.particles();
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (p.kind[i] == Kind::fluid) p.acceleration[i][0] += amplitude * std::sin(phase);
+  }
+  T stable_time_step(const System2&) const { return std::numeric_limits<T>::max(); }
+  void advance(System2&, T, T dt) { phase += omega * dt; }
+  template <class Writer>
+  void save_checkpoint(Writer& w) const {
+    w.write("shaker.phase", phase);
+  }
+  template <class Reader>
+  void load_checkpoint(Reader& r) {
+    r.read("shaker.phase", phase);
+  }
+};
+
+// A model without state between steps says so.
+struct ExtraGravity {
+  static constexpr bool checkpoint_stateless = true;
+  void compute_rates(System2& system, T) {
+    auto& p = system.particles();
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (p.kind[i] == Kind::fluid) p.acceleration[i][1] -= T(0.5);
+  }
+  T stable_time_step(const System2&) const { return std::numeric_limits<T>::max(); }
+  void advance(System2&, T, T) {}
+};
+
+TEST_CASE("Robustness: a checkpoint carries the state of extra particle models", "[robustness][checkpoint]") {
+  using Sim = Simulation<System2, SymplecticVerlet, Shaker, ExtraGravity>;
+  const fs::path file = output_dir() / "restart_models.chk";
+  System2 reference_system(tank_domain, water);
+  build_dam_break(reference_system);
+  Sim reference(reference_system, {}, {}, Shaker{}, ExtraGravity{});
+  for (int s = 0; s < 50; ++s) reference.step();
+  {
+    System2 first_system(tank_domain, water);
+    build_dam_break(first_system);
+    Sim first(first_system, {}, {}, Shaker{}, ExtraGravity{});
+    for (int s = 0; s < 20; ++s) first.step();
+    io::write_checkpoint(file, first);
+  }
+  System2 resumed_system(tank_domain, water);
+  Sim resumed(resumed_system, {}, {}, Shaker{}, ExtraGravity{});
+  io::read_checkpoint(file, resumed);
+  CHECK(resumed.model<0>().phase > 0);
+  for (int s = 20; s < 50; ++s) resumed.step();
+  require_bit_identical(reference, resumed);
+  CHECK(resumed.model<0>().phase == reference.model<0>().phase);
+
+  // The file belongs to a simulation with two models: one with another set of models is refused.
+  System2 other_system(tank_domain, water);
+  Simulation<System2, SymplecticVerlet, ExtraGravity> other(other_system, {}, {}, ExtraGravity{});
+  CHECK_THROWS_WITH(io::read_checkpoint(file, other), Catch::Contains("written with 2 particle models"));
+}
+
 std::vector<char> file_bytes(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};

@@ -16,10 +16,12 @@
 // while writing leaves the previous checkpoint intact. A truncated, corrupt or incompatible file gives an
 // InputError that says what is wrong.
 //
-// Models with state of their own take part when they provide
-//   template <class Writer> void save_checkpoint(Writer&) const;  template <class Reader> void
-//   load_checkpoint(Reader&);
-// using CheckpointWriter::write / CheckpointReader::read; models without them are taken to be stateless.
+// Every extra ParticleModel of the Simulation must say how it is restarted, or checkpointing does not compile
+// (a model whose state were silently dropped would make the resumed run differ). Either it saves its state,
+//   template <class Writer> void save_checkpoint(Writer&) const;
+//   template <class Reader> void load_checkpoint(Reader&);
+// with CheckpointWriter::write / CheckpointReader::read, or it declares that it keeps none between steps:
+//   static constexpr bool checkpoint_stateless = true;
 #pragma once
 
 #include <sphfsi/core/error.hpp>
@@ -221,6 +223,19 @@ concept CheckpointableModel = requires(const Model& cm, Model& m, CheckpointWrit
   m.load_checkpoint(r);
 };
 
+template <class Model>
+concept StatelessModel = requires {
+  requires Model::checkpoint_stateless;
+};
+
+template <class Model>
+constexpr void require_restartable() {
+  static_assert(CheckpointableModel<Model> || StatelessModel<Model>,
+                "sphfsi checkpoint: this ParticleModel does not say how it restarts: give it "
+                "save_checkpoint(Writer&) const and load_checkpoint(Reader&), or declare "
+                "static constexpr bool checkpoint_stateless = true if it keeps no state between steps");
+}
+
 /// Writes bytes to path atomically: a temporary file next to it, flushed to disk, then renamed over it.
 inline void write_file_atomically(const std::filesystem::path& path, const std::vector<char>& bytes) {
   const std::filesystem::path tmp = path.string() + ".tmp";
@@ -366,6 +381,7 @@ void write_checkpoint(const std::filesystem::path& path, const Sim& sim) {
         [&] {
           const auto& model = sim.template model<I>();
           using Model = std::remove_cvref_t<decltype(model)>;
+          detail::require_restartable<Model>();
           const std::uint8_t has_state = detail::CheckpointableModel<Model> ? 1 : 0;
           w.write(fmt::format("model.{}.has_state", I), has_state);
           if constexpr (detail::CheckpointableModel<Model>) model.save_checkpoint(w);
@@ -488,6 +504,7 @@ void read_checkpoint(const std::filesystem::path& path, Sim& sim) {
         [&] {
           auto& model = sim.template model<I>();
           using Model = std::remove_cvref_t<decltype(model)>;
+          detail::require_restartable<Model>();
           std::uint8_t has_state = 0;
           r.read(fmt::format("model.{}.has_state", I), has_state);
           if (has_state != (detail::CheckpointableModel<Model> ? 1 : 0))
