@@ -19,3 +19,9 @@
 #include <sphfsi/kernel/wendland_c2.hpp>
 #include <sphfsi/neighbors/cell_list.hpp>
 #include <sphfsi/scenes/builders.hpp>
+#include <sphfsi/scenes/solid_builders.hpp>
+#include <sphfsi/solid/body.hpp>
+#include <sphfsi/solid/concepts.hpp>
+#include <sphfsi/solid/elastic_material.hpp>
+#include <sphfsi/solid/total_lagrangian.hpp>
+#include <sphfsi/solid/updated_lagrangian.hpp>
