@@ -14,6 +14,7 @@
 #include <limits>
 #include <map>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 namespace sphfsi {
@@ -38,6 +39,14 @@ template <int Dim, Real T>
 struct PrescribedMotion {
   std::function<Vec<Dim, T>(T)> displacement;
   std::function<Vec<Dim, T>(T)> velocity;
+};
+
+/// A prescribed motion of each particle of a wall group from its initial (reference) position, for motions that are
+/// not rigid translations (a flap wavemaker rotating about its hinge): state(reference, t) returns the particle's
+/// {position, velocity} at time t.
+template <int Dim, Real T>
+struct PrescribedKinematics {
+  std::function<std::pair<Vec<Dim, T>, Vec<Dim, T>>(const Vec<Dim, T>&, T)> state;
 };
 
 template <class System, class Integrator, class... Models>
@@ -75,9 +84,15 @@ class Simulation {
     if (!motion.displacement || !motion.velocity)
       throw InputError("set_wall_motion: both displacement(t) and velocity(t) must be given");
     motions_[body] = std::move(motion);
-    const auto& p = system_.particles();
-    reference_position_.resize(p.size());
-    for (std::size_t i = 0; i < p.size(); ++i) reference_position_[p.id[i]] = p.position[i];
+    record_reference_positions();
+  }
+
+  /// Moves each wall particle of `body` to kinematics.state(its initial position, t) (e.g. a flap rotating about a
+  /// hinge). Like set_wall_motion, call it before the first step; a body has one motion or one kinematics.
+  void set_wall_kinematics(std::int32_t body, PrescribedKinematics<Dim, T> kinematics) {
+    if (!kinematics.state) throw InputError("set_wall_kinematics: state(reference_position, t) must be given");
+    kinematics_[body] = std::move(kinematics);
+    record_reference_positions();
   }
 
   /// Advances one time step; returns the step taken.
@@ -120,7 +135,7 @@ class Simulation {
                      bool rates_evaluated = true) {
     require_finite("Simulation::restore_state time (s)", time);
     require_non_negative("Simulation::restore_state last_dt (s)", last_dt);
-    if (!motions_.empty() && wall_reference_positions.size() != system_.particles().size())
+    if ((!motions_.empty() || !kinematics_.empty()) && wall_reference_positions.size() != system_.particles().size())
       throw InputError(fmt::format("Simulation::restore_state wall_reference_positions has {} entries: with moving "
                                    "walls it needs one per particle ({})",
                                    wall_reference_positions.size(), system_.particles().size()));
@@ -143,8 +158,16 @@ class Simulation {
 
   /// Places moving wall particles at their prescribed position and velocity at time t.
   void move_walls(T t) {
-    if (motions_.empty()) return;
+    if (motions_.empty() && kinematics_.empty()) return;
     auto& p = system_.particles();
+    for (const auto& [body, kinematics] : kinematics_) {
+      for (std::size_t i = 0; i < p.size(); ++i) {
+        if (p.kind[i] != Kind::wall || p.body[i] != body) continue;
+        const auto [x, v] = kinematics.state(reference_position_[p.id[i]], t);
+        p.position[i] = x;
+        p.velocity[i] = v;
+      }
+    }
     for (const auto& [body, motion] : motions_) {
       const Vector d = motion.displacement(t), v = motion.velocity(t);
       for (std::size_t i = 0; i < p.size(); ++i) {
@@ -190,6 +213,12 @@ class Simulation {
   }
 
  private:
+  void record_reference_positions() {
+    const auto& p = system_.particles();
+    reference_position_.resize(p.size());
+    for (std::size_t i = 0; i < p.size(); ++i) reference_position_[p.id[i]] = p.position[i];
+  }
+
   void initialise() {
     initialised_ = true;
     move_walls(time_);
@@ -201,6 +230,7 @@ class Simulation {
   TimeStepParameters<T> time_step_;
   std::tuple<Models...> models_;
   std::map<std::int32_t, PrescribedMotion<Dim, T>> motions_;
+  std::map<std::int32_t, PrescribedKinematics<Dim, T>> kinematics_;
   std::vector<Vector> reference_position_;
   T time_{0}, dt_{0};
   T end_limit_ = std::numeric_limits<T>::max();

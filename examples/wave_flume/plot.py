@@ -1,0 +1,36 @@
+"""Plots of examples/wave_flume: gauge records and H(x). Usage: plot.py OUTPUT_FOLDER"""
+import csv
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+
+
+def read(path):
+    with open(path) as f:
+        rows = [r for r in csv.reader(line for line in f if not line.startswith("#"))]
+    header, data = rows[0], rows[1:]
+    return {name: [float(r[i]) for r in data] for i, name in enumerate(header)}
+
+
+out = sys.argv[1]
+g = read(f"{out}/gauges.csv")
+h = read(f"{out}/wave_heights.csv")
+fig, (a, b) = plt.subplots(2, 1, figsize=(8, 7))
+names = [n for n in g if n.startswith("eta_")]
+for k, n in enumerate(names):
+    a.plot(g["t"], [1000 * v + 40 * k for v in g[n]], lw=0.8, label=f"x = {float(n[4:]):.2f} m (+{40 * k} mm)")
+a.set_xlabel("t (s)")
+a.set_ylabel("eta (mm), offset per gauge")
+a.legend(fontsize=7, loc="upper left")
+b.plot(h["x_over_L"], h["H_over_target"], "o-", label="SPH (zero up-crossing mean)")
+b.axhline(1.0, color="k", lw=0.8, label="target (Biesel, linear theory)")
+b.axhspan(0.95, 1.05, color="g", alpha=0.1, label="+-5 %")
+b.set_xlabel("x / L")
+b.set_ylabel("H / H_target")
+b.legend(fontsize=8)
+fig.tight_layout()
+fig.savefig(f"{out}/wave_flume.png", dpi=110)
+print(f"plot: {out}/wave_flume.png")

@@ -1,0 +1,273 @@
+// Tests of the wave flume tools: linear theory and Biesel transfer functions, the wavemaker's motion, zero-crossing
+// analysis, the Dalrymple et al. (1984) decay fit and drag-coefficient inversion, the damping zone and the gauges.
+#include <sphfsi/analysis/vegetation_drag.hpp>
+#include <sphfsi/analysis/zero_crossing.hpp>
+#include <sphfsi/eos/tait.hpp>
+#include <sphfsi/kernel/wendland_c2.hpp>
+#include <sphfsi/scenes/wave_flume.hpp>
+#include <sphfsi/waves/damping_zone.hpp>
+#include <sphfsi/waves/gauges.hpp>
+#include <sphfsi/waves/linear_theory.hpp>
+#include <sphfsi/waves/wavemaker.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <vector>
+
+using namespace sphfsi;
+using Catch::Matchers::WithinAbs;
+using Catch::Matchers::WithinRel;
+
+namespace {
+constexpr double pi = std::numbers::pi;
+
+// Biesel's progressive-wave height over stroke for a paddle excursion (S/2) f(s), s the height above the bed:
+// H/S = 4 sinh(kh) k Int_0^h f(s) cosh(k s) ds / (sinh 2kh + 2kh), by Simpson's rule (independent of the closed forms).
+template <class F>
+double biesel_by_quadrature(double kh, F profile) {
+  const int n = 2000;
+  double sum = 0;
+  for (int i = 0; i <= n; ++i) {
+    const double u = double(i) / n;  // s / h
+    const double w = (i == 0 || i == n) ? 1 : (i % 2 ? 4 : 2);
+    sum += w * profile(u) * std::cosh(kh * u);
+  }
+  const double integral = sum / (3.0 * n) * kh;  // k Int_0^h f cosh(ks) ds = kh Int_0^1 f(u) cosh(kh u) du
+  return 4 * std::sinh(kh) * integral / (std::sinh(2 * kh) + 2 * kh);
+}
+}  // namespace
+
+TEST_CASE("dispersion relation: the known answer of validation-cases.md section 4", "[waves]") {
+  // h = 0.16 m, T = 1.4286 s: k = 3.706 1/m, L = 1.695 m, piston H/S = 0.591 (given to the digits shown)
+  const auto w = waves::linear_wave(1.4286, 0.16);
+  CHECK_THAT(w.wave_number, WithinAbs(3.706, 0.0005));
+  CHECK_THAT(w.wavelength, WithinAbs(1.695, 0.0005));
+  CHECK_THAT(w.kh(), WithinAbs(0.593, 0.0005));
+  CHECK_THAT(waves::piston_height_to_stroke(w.kh()), WithinAbs(0.591, 0.0005));
+  // float gives the same to float precision
+  const auto wf = waves::linear_wave(1.4286f, 0.16f);
+  CHECK_THAT(double(wf.wave_number), WithinRel(w.wave_number, 1e-6));
+}
+
+TEST_CASE("dispersion relation: residual and limits at all depths", "[waves]") {
+  const double g = 9.81;
+  for (double depth : {1e-3, 0.01, 0.16, 1.0, 10.0, 1000.0}) {
+    for (double period : {0.3, 1.4286, 10.0}) {
+      const auto w = waves::linear_wave(period, depth, g);
+      const double omega = 2 * pi / period;
+      CHECK_THAT(g * w.wave_number * std::tanh(w.kh()), WithinRel(omega * omega, 1e-12));
+      CHECK_THAT(w.celerity * period, WithinRel(w.wavelength, 1e-12));
+      if (w.kh() < 0.05) {  // shallow water: c -> sqrt(g h), c_g -> c, to O((kh)^2)
+        CHECK_THAT(w.celerity, WithinRel(std::sqrt(g * depth), w.kh() * w.kh()));
+        CHECK_THAT(w.group_velocity, WithinRel(w.celerity, w.kh() * w.kh()));
+      }
+      if (w.kh() > 10) {  // deep water: k -> omega^2 / g, c_g -> c / 2, to O(exp(-2kh))
+        CHECK_THAT(w.wave_number, WithinRel(omega * omega / g, 1e-8));
+        CHECK_THAT(w.group_velocity, WithinRel(0.5 * w.celerity, 1e-8));
+      }
+    }
+  }
+  CHECK_THROWS_AS(waves::wave_number(0.0, 1.0), InputError);
+  CHECK_THROWS_AS(waves::wave_number(1.0, -1.0), InputError);
+}
+
+TEST_CASE("Biesel transfer functions: closed forms against the quadrature of Biesel's integral, and limits", "[waves]") {
+  for (double kh : {0.05, 0.3, 0.593, 1.0, 2.0, 4.0}) {
+    // Simpson with 2000 intervals: relative error ~ (kh/2000)^4, far below 1e-9
+    CHECK_THAT(waves::piston_height_to_stroke(kh), WithinRel(biesel_by_quadrature(kh, [](double) { return 1.0; }), 1e-9));
+    CHECK_THAT(waves::flap_height_to_stroke(kh), WithinRel(biesel_by_quadrature(kh, [](double u) { return u; }), 1e-9));
+  }
+  // shallow water: piston H/S -> kh (the displaced volume S h fills a crest of the wave), flap -> kh / 2
+  for (double kh : {1e-4, 1e-3}) {
+    CHECK_THAT(waves::piston_height_to_stroke(kh), WithinRel(kh, kh));
+    CHECK_THAT(waves::flap_height_to_stroke(kh), WithinRel(kh / 2, kh));
+  }
+  // deep water: both -> 2
+  CHECK_THAT(waves::piston_height_to_stroke(20.0), WithinRel(2.0, 1e-12));
+  CHECK_THAT(waves::flap_height_to_stroke(20.0), WithinRel(2.0, 0.06));  // 2 (1 - 1/kh): 5 % below at kh = 20
+  CHECK_THROWS_AS(waves::piston_height_to_stroke(0.0), InputError);
+}
+
+TEST_CASE("wavemaker: Biesel stroke, ramp, velocity, piston and flap motions", "[waves]") {
+  waves::WavemakerParameters<double> p;  // h = 0.16 m, T = 1.4286 s, H = 0.028 m, piston, 2-period ramp
+  const waves::Wavemaker<double> piston(p);
+  const double ratio = waves::piston_height_to_stroke(piston.wave().kh());
+  CHECK_THAT(piston.stroke(), WithinRel(0.028 / ratio, 1e-12));
+  CHECK_THAT(piston.stroke(), WithinAbs(0.0474, 0.0001));  // 0.028 / 0.591
+  // starts from rest; full amplitude S/2 after the ramp
+  CHECK(piston.displacement(0.0) == 0.0);
+  CHECK(piston.velocity(0.0) == 0.0);
+  const double T = p.period, tr = piston.ramp_time();
+  CHECK_THAT(tr, WithinRel(2 * T, 1e-15));
+  CHECK_THAT(piston.displacement(tr + 0.25 * T), WithinRel(0.5 * piston.stroke(), 1e-12));
+  // velocity is the time derivative of the displacement (central differences, error ~ dt^2 X''' ~ 1e-10 m/s)
+  for (double t : {0.1, 0.7, 1.5, 2.8, 2.9, 5.0}) {
+    const double dt = 1e-5;
+    const double fd = (piston.displacement(t + dt) - piston.displacement(t - dt)) / (2 * dt);
+    CHECK_THAT(piston.velocity(t), WithinAbs(fd, 1e-8));
+  }
+  const auto motion = piston.piston_motion<2>();
+  CHECK(motion.displacement(3.3)[0] == piston.displacement(3.3));
+  CHECK(motion.displacement(3.3)[1] == 0.0);
+  CHECK_THROWS_AS(piston.flap_kinematics<2>(0.0), InputError);
+
+  p.paddle = waves::PaddleType::flap;
+  const waves::Wavemaker<double> flap(p);
+  CHECK_THAT(flap.stroke(), WithinRel(0.028 / waves::flap_height_to_stroke(flap.wave().kh()), 1e-12));
+  CHECK(flap.stroke() > piston.stroke());  // a flap displaces less water per stroke
+  const auto k = flap.flap_kinematics<2>(0.0, 0.0);
+  for (double t : {1.0, 3.3, 4.0}) {
+    // the paddle line crosses the still-water level at x = X(t); points keep their distance to the hinge
+    const Vec<2, double> bottom(0, 0.01), top(0, 0.2);
+    const auto [xb, vb] = k.state(bottom, t);
+    const auto [xt, vt] = k.state(top, t);
+    const double x_at_surface = xb[0] + (xt[0] - xb[0]) * (0.16 - xb[1]) / (xt[1] - xb[1]);
+    CHECK_THAT(x_at_surface, WithinAbs(flap.displacement(t), 1e-14));
+    CHECK_THAT(xt.norm(), WithinRel(0.2, 1e-14));
+    // velocity is the time derivative of the position
+    const double dt = 1e-6;
+    const Vec<2, double> fd = (k.state(top, t + dt).first - k.state(top, t - dt).first) / (2 * dt);
+    CHECK_THAT(vt[0], WithinAbs(fd[0], 1e-8));
+    CHECK_THAT(vt[1], WithinAbs(fd[1], 1e-8));
+  }
+  waves::WavemakerParameters<double> bad;
+  bad.wave_height = 1.0;  // needs a stroke beyond the depth
+  CHECK_THROWS_AS(waves::Wavemaker<double>(bad), InputError);
+  bad = {};
+  bad.period = -1;
+  CHECK_THROWS_AS(waves::Wavemaker<double>(bad), InputError);
+}
+
+TEST_CASE("zero-crossing analysis of synthetic records", "[waves][analysis]") {
+  const double T = 1.4286, a = 0.014, dt = T / 40;
+  std::vector<double> t, eta, eta2;
+  for (int i = 0; i <= 40 * 12; ++i) {
+    const double ti = i * dt;
+    t.push_back(ti);
+    eta.push_back(0.003 + a * std::sin(2 * pi * ti / T + 0.3));  // offset removed by the analysis
+    // a Stokes-like second harmonic: crests sharper than troughs; H from a dense evaluation of the same signal
+    eta2.push_back(a * std::cos(2 * pi * ti / T) + 0.2 * a * std::cos(4 * pi * ti / T));
+  }
+  const auto w = analysis::zero_crossing_analysis(t, eta, 2.0, t.back());
+  CHECK(w.count() >= 9);
+  // samples every T/40 miss a crest by at most half a step: H low by at most a (1 - cos(pi/40)) per extremum
+  CHECK_THAT(w.mean_height, WithinAbs(2 * a, 2 * a * (1 - std::cos(pi / 40))));
+  // crossing times by linear interpolation: error ~ (dt^2 / 8) |eta''| / |eta'| at a crossing = dt^2 (2 pi/T) / 8
+  CHECK_THAT(w.mean_period, WithinAbs(T, 1e-3));
+  CHECK_THAT(w.mean_level, WithinAbs(0.003, 2 * a / 10));  // window not a whole number of periods
+  const auto down = analysis::zero_crossing_analysis(t, eta, 2.0, t.back(), analysis::Crossing::down);
+  CHECK_THAT(down.mean_height, WithinAbs(2 * a, 2 * a * (1 - std::cos(pi / 40))));
+
+  double hi = -1, lo = 1;
+  for (int i = 0; i < 100000; ++i) {
+    const double s = T * i / 100000.0;
+    const double e = a * std::cos(2 * pi * s / T) + 0.2 * a * std::cos(4 * pi * s / T);
+    hi = std::max(hi, e), lo = std::min(lo, e);
+  }
+  const auto w2 = analysis::zero_crossing_analysis(t, eta2, 0.0, t.back());
+  CHECK_THAT(w2.mean_height, WithinRel(hi - lo, 0.01));  // sampling error as above, at most ~0.6 %
+  CHECK_THAT(w2.mean_period, WithinAbs(T, 1e-3));
+
+  CHECK_THROWS_AS(analysis::zero_crossing_analysis(t, eta, 2.0, 2.5), InputError);  // no complete wave
+  eta[100] = std::nan("");
+  CHECK_THROWS_AS(analysis::zero_crossing_analysis(t, eta, 0.0, t.back()), InputError);
+}
+
+TEST_CASE("Dalrymple decay: fit and C_D inversion recover a known drag coefficient", "[waves][analysis]") {
+  // Luhar et al. (2017)-like meadow: h = 0.16 m, T = 1.4286 s, stems 0.13 m tall, 3 mm wide, 7200 per m^2
+  const auto w = waves::linear_wave(1.4286, 0.16);
+  const analysis::StemField stems{0.13, 0.003, 7200};
+  const double cd = 1.4, H0 = 0.028;
+  const double alpha = analysis::dalrymple_alpha(cd, stems, H0, w.wave_number, 0.16);
+  std::vector<double> x, H;
+  for (int i = 0; i <= 25; ++i) {
+    x.push_back(0.2 * i);
+    H.push_back(H0 / (1 + alpha * x.back()));
+  }
+  // exact data: exact recovery
+  const auto exact = analysis::fit_decay(x, H);
+  CHECK_THAT(exact.alpha, WithinRel(alpha, 1e-9));
+  CHECK_THAT(exact.incident_height, WithinRel(H0, 1e-9));
+  CHECK_THAT(analysis::drag_coefficient(exact, stems, w.wave_number, 0.16).value, WithinRel(cd, 1e-9));
+  CHECK(exact.se_alpha() < 1e-9 * alpha);
+  const auto fixed = analysis::fit_decay(x, H, H0);
+  CHECK_THAT(fixed.alpha, WithinRel(alpha, 1e-9));
+
+  // noisy data: the standard error must describe the scatter of the estimates. Over 400 realisations with 2 %
+  // Gaussian noise, the truth lies within one standard error of the estimate in about 68 % of them; the binomial
+  // standard deviation of that fraction is sqrt(0.68 * 0.32 / 400) = 2.3 %, so [0.58, 0.78] is +-4.3 sigma.
+  std::mt19937 rng(2017);
+  std::normal_distribution<double> noise(0.0, 0.02);
+  int inside = 0;
+  const int trials = 400;
+  for (int trial = 0; trial < trials; ++trial) {
+    std::vector<double> Hn(H);
+    for (double& v : Hn) v *= 1 + noise(rng);
+    const auto fit = analysis::fit_decay(x, Hn);
+    const auto c = analysis::drag_coefficient(fit, stems, w.wave_number, 0.16);
+    if (std::abs(c.value - cd) <= c.standard_error) ++inside;
+    if (trial == 0) {
+      INFO("C_D = " << c.value << " +- " << c.standard_error);
+      CHECK(std::abs(c.value - cd) <= 3 * c.standard_error);
+      CHECK(c.standard_error < 0.2 * cd);
+    }
+  }
+  const double coverage = double(inside) / trials;
+  INFO("one-standard-error coverage " << coverage);
+  CHECK(coverage > 0.58);
+  CHECK(coverage < 0.78);
+
+  CHECK_THROWS_AS(analysis::fit_decay(std::vector<double>{0, 1}, std::vector<double>{1, 0.9}), InputError);
+  CHECK_THROWS_AS(analysis::fit_decay(std::vector<double>{0, 1, 2}, std::vector<double>{1, -0.9, 0.8}), InputError);
+  CHECK_THROWS_AS(analysis::dalrymple_wave_factor(w.wave_number, 0.16, 0.2), InputError);  // stems above water
+}
+
+TEST_CASE("damping zone: relaxation rate profile and velocity decay", "[waves]") {
+  using System = ParticleSystem<2, double, WendlandC2<2>, Tait<double>>;
+  System system(Domain<2, double>(Vec<2, double>(-1, -1), Vec<2, double>(3, 1)), Tait<double>(1000, 10));
+  waves::DampingZone<double> zone{1.0, 2.0, 10.0};
+  zone.validate();
+  CHECK(zone.rate(0.5) == 0.0);
+  CHECK(zone.rate(1.0) == 0.0);
+  CHECK_THAT(zone.rate(1.5), WithinRel(2.5, 1e-15));
+  CHECK_THAT(zone.rate(2.5), WithinRel(10.0, 1e-15));
+  auto& p = system.particles();
+  for (double x : {0.5, 1.5, 2.5}) p.add(Kind::fluid, Vec<2, double>(x, 0), Vec<2, double>(1, -1), 1000, 1, 0.1);
+  p.add(Kind::wall, Vec<2, double>(2.5, -0.5), Vec<2, double>(1, 0), 1000, 1, 0.1);
+  zone.advance(system, 0.0, 0.01);
+  CHECK(p.velocity[0][0] == 1.0);
+  CHECK_THAT(p.velocity[1][0], WithinRel(std::exp(-0.025), 1e-14));
+  CHECK_THAT(p.velocity[2][1], WithinRel(-std::exp(-0.1), 1e-14));
+  CHECK(p.velocity[3][0] == 1.0);  // walls untouched
+  waves::DampingZone<double> bad{1.0, 1.0, 10.0};
+  CHECK_THROWS_AS(bad.validate(), InputError);
+}
+
+TEST_CASE("wave gauge: the surface of a still flume at the still-water level", "[waves]") {
+  using System = ParticleSystem<2, double, WendlandC2<2>, Tait<double>>;
+  scenes::WaveFlumeGeometry<double> g;
+  g.particles_per_depth = 10;
+  g.length_wavelengths = 1;
+  g.damping_wavelengths = 0.3;
+  System system(scenes::wave_flume_domain(g), Tait<double>(1000, g.sound_speed()));
+  const auto layout = scenes::build_wave_flume(system, g);
+  CHECK(layout.fluid_particles == std::size_t(std::llround(g.length() / g.dp())) * 10);
+  // The half-level of the colour of a half-space lies on its boundary (the kernel is even). The lattice's top row
+  // sits dp/2 below z = h, so the discrete colour's half-level is there up to the kernel quadrature error on the
+  // lattice, a few per cent of dp for h_sph = 1.3 dp: allow dp/10.
+  for (double x : {0.3, 0.8, 1.2}) {
+    const double eta = waves::free_surface_elevation(system, x, layout.still_level, g.dp());
+    INFO("x = " << x << " eta/dp = " << eta / g.dp());
+    CHECK(std::abs(eta) < 0.1 * g.dp());
+  }
+  CHECK(std::isnan(waves::free_surface_elevation(system, -5.0, layout.still_level, g.dp())));
+  waves::WaveGauges<double> gauges({0.5, 1.0}, layout.still_level, g.dp());
+  CHECK(gauges.column_name(1) == "eta_1.0000");
+  CHECK(waves::gauge_position("eta_1.0000").value() == 1.0);
+  CHECK_FALSE(waves::gauge_position("t").has_value());
+  gauges.sample(system, 0.0);
+  CHECK(gauges.series(0).size() == 1);
+}
