@@ -1,0 +1,132 @@
+// Tests of the three FSI coupling policies: each conserves the linear momentum of the fluid-solid pair to round-off.
+#include <sphfsi/core/particle_system.hpp>
+#include <sphfsi/coupling/coupled_body.hpp>
+#include <sphfsi/coupling/interface_pressure.hpp>
+#include <sphfsi/coupling/repulsive_force.hpp>
+#include <sphfsi/coupling/stress_continuity.hpp>
+#include <sphfsi/eos/tait.hpp>
+#include <sphfsi/integrators/simulation.hpp>
+#include <sphfsi/integrators/symplectic.hpp>
+#include <sphfsi/kernel/cubic_spline.hpp>
+#include <sphfsi/scenes/builders.hpp>
+#include <sphfsi/scenes/solid_builders.hpp>
+#include <sphfsi/solid/total_lagrangian.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <random>
+
+using namespace sphfsi;
+
+namespace {
+
+using System = ParticleSystem<2, double, CubicSpline<2>, Tait<double>>;
+using V = Vec<2, double>;
+using Solid = TotalLagrangianSolid<System>;
+
+// A free fluid block pressing on a free elastic plate, in vacuum (no walls, no gravity), with random velocities:
+// every force in the scene is an internal pair force, so total momentum must stay constant.
+System make_scene() {
+  System system(Domain<2, double>(V(-0.2, -0.2), V(0.3, 0.3)), Tait<double>(1000, 20));
+  const Resolution<double> res{0.005, 1.3};
+  add_fluid_block(system, V(0, 0), V(0.05, 0.06), res, 0.06, 9.81);  // hydrostatic density: pressure pushes
+  ElasticMaterial<double> rubber;
+  rubber.density = 1100;
+  rubber.youngs_modulus = 1.2e7;
+  rubber.poisson_ratio = 0.4;
+  add_solid_block(system, V(0.05, 0), V(0.07, 0.06), res, rubber, 1);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-0.2, 0.2);
+  for (auto& v : system.particles().velocity) v = V(u(rng), u(rng));
+  return system;
+}
+
+ElasticMaterial<double> rubber() {
+  ElasticMaterial<double> m;
+  m.density = 1100;
+  m.youngs_modulus = 1.2e7;
+  m.poisson_ratio = 0.4;
+  return m;
+}
+
+V momentum(const System& s) {
+  V p = V::Zero();
+  for (std::size_t i = 0; i < s.size(); ++i) p += s.particles().mass[i] * s.particles().velocity[i];
+  return p;
+}
+
+template <class Coupling>
+void check_coupling(const Coupling& coupling) {
+  System system = make_scene();
+  TotalLagrangianParameters<2, double> params;
+  params.gravity = V::Zero();
+  Solid solid(system, 1, rubber(), params);
+  FluidParameters<2, double> fluid;
+  fluid.gravity = V::Zero();
+  using Body = CoupledBody<Coupling, Solid>;
+  Simulation<System, SymplecticVerlet, Body> sim(system, fluid, {}, Body(coupling, std::move(solid)));
+
+  // 1. Instantaneous: the coupling's forces alone sum to zero.
+  sim.evaluate_rates(0.0);
+  auto& p = system.particles();
+  std::vector<V> before(p.size());
+  for (std::size_t i = 0; i < p.size(); ++i) before[i] = p.acceleration[i];
+  for (std::size_t i = 0; i < p.size(); ++i) p.acceleration[i] = V::Zero();
+  coupling.apply(system, sim.template model<0>().solid(), 0.0);
+  V total = V::Zero();
+  double scale = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    total += p.mass[i] * p.acceleration[i];
+    scale += p.mass[i] * p.acceleration[i].norm();
+  }
+  INFO(Coupling::name << ": sum m a = " << total.transpose() << ", sum |m a| = " << scale);
+  REQUIRE(scale > 0);  // the coupling acts
+  CHECK(total.norm() <= 1e-12 * scale);
+  for (std::size_t i = 0; i < p.size(); ++i) p.acceleration[i] = before[i];
+
+  // 2. Over 30 steps of the coupled run (fluid pairs, coupling, sub-cycled solid): momentum kept to round-off.
+  const V p0 = momentum(system);
+  double scale_p = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) scale_p += p.mass[i] * p.velocity[i].norm();
+  for (int k = 0; k < 30; ++k) sim.step();
+  const V p1 = momentum(system);
+  INFO(Coupling::name << ": momentum drift " << (p1 - p0).transpose() << " of sum |m v| " << scale_p);
+  CHECK((p1 - p0).norm() <= 1e-12 * scale_p);
+}
+
+}  // namespace
+
+TEST_CASE("stress continuity conserves fluid-solid momentum", "[coupling]") {
+  check_coupling(StressContinuity<double>{});
+}
+TEST_CASE("interface pressure conserves fluid-solid momentum", "[coupling]") {
+  check_coupling(InterfacePressure<double>{});
+}
+TEST_CASE("repulsive force conserves fluid-solid momentum", "[coupling]") {
+  RepulsiveForce<double> c;
+  check_coupling(c);
+}
+
+TEST_CASE("solid surface normals point out of a block", "[coupling]") {
+  System system = make_scene();
+  Solid solid(system, 1, rubber());
+  system.update_neighbors();
+  std::vector<char> surface;
+  update_solid_surface(system, solid.particle_ids(), 1, surface);
+  const auto& p = system.particles();
+  std::size_t n_surface = 0;
+  for (std::size_t k = 0; k < surface.size(); ++k) {
+    const std::size_t s = p.slot_of_id(solid.particle_ids()[k]);
+    const V x = p.position[s];
+    // The block [0.05, 0.07] x [0, 0.06] has 4 columns: the two outer ones and the top/bottom rows are surface.
+    const bool edge = x[0] < 0.055 || x[0] > 0.065 || x[1] < 0.005 || x[1] > 0.055;
+    CHECK(static_cast<bool>(surface[k]) == edge);
+    if (surface[k]) {
+      ++n_surface;
+      CHECK(std::abs(p.normal[s].norm() - 1) < 1e-12);
+      const V centre(0.06, 0.03);
+      CHECK(p.normal[s].dot(x - centre) > 0);  // outward
+    }
+  }
+  CHECK(n_surface == 2 * 12 + 2 * 2);
+}
