@@ -25,7 +25,7 @@ struct AntociGate {
   T column_height{T(0.14)};   ///< H
   T gate_length{T(0.079)};    ///< L
   T gate_thickness{T(0.005)}; ///< s
-  T tank_length{T(0.5)};      ///< downstream floor ends in a wall at this x
+  T tank_length{T(1.2)};      ///< downstream floor ends in a wall here (spray reaches ~0.8 m by 0.4 s)
   // Table 2 properties.
   T fluid_density{T(1000)};   ///< kg/m^3
   T fluid_sound_speed{T(20)}; ///< c0, m/s (>= 10 x the largest flow speed sqrt(2 g H) = 1.66 m/s)
@@ -70,7 +70,7 @@ struct AntociGate {
   }
   Domain<2, T> domain() const {
     const T m = T(6) * dp();
-    return Domain<2, T>(Vec<2, T>(-m, -m), Vec<2, T>(tank_length + m, column_height + T(0.03) + m));
+    return Domain<2, T>(Vec<2, T>(-m, -m), Vec<2, T>(tank_length + m, T(2) * column_height + m));
   }
   FluidParameters<2, T> fluid() const {
     FluidParameters<2, T> f;

@@ -38,16 +38,17 @@ struct GateTipComparison {
   std::size_t points{0};
 };
 
-/// RMS error at the experiment's times 0.04 ... 0.36 s (experiment = mean of the two digitizations where both
-/// exist). Times the run did not reach count as missing: a run that stopped early reports NaN.
+/// RMS error at the experiment's times 0.04 ... min(0.36, t_max) s (experiment = mean of the two digitizations
+/// where both exist). A time inside that window that the run did not reach makes the error NaN (a run that stopped
+/// early has no score).
 template <class T>
-GateTipComparison<T> compare_gate_tip(const GateTipRecord<T>& sim, const io::CsvTable& data) {
+GateTipComparison<T> compare_gate_tip(const GateTipRecord<T>& sim, const io::CsvTable& data, T t_max = T(0.36)) {
   const auto t = data.column("t"), dx = data.column("dx"), dy = data.column("dy");
   const auto dx2 = data.column("dx_alt"), dy2 = data.column("dy_alt");
   GateTipComparison<T> c;
   T sx = 0, sy = 0;
   for (std::size_t k = 0; k < t.size(); ++k) {
-    if (t[k] < 0.039 || t[k] > 0.361) continue;
+    if (t[k] < 0.039 || t[k] > std::min(0.361, double(t_max) + 1e-9)) continue;
     const T ex = std::isnan(dx2[k]) ? T(dx[k]) : T(0.5 * (dx[k] + dx2[k]));
     const T ey = std::isnan(dy2[k]) ? T(dy[k]) : T(0.5 * (dy[k] + dy2[k]));
     const T ex_sim = sim.at(sim.dx, T(t[k])), ey_sim = sim.at(sim.dy, T(t[k]));

@@ -1,0 +1,84 @@
+"""Chart and table of the Antoci-gate coupling comparison (benchmarks/run_coupling_comparison.sh).
+
+usage: /usr/bin/python3 benchmarks/coupling_chart.py <runs folder> <docs folder>
+Writes <docs>/img/coupling_error_vs_time.png, <docs>/img/coupling_tip_curves.png and prints a Markdown table.
+"""
+import csv
+import glob
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def read(path):
+    with open(path) as f:
+        rows = list(csv.reader(line for line in f if not line.startswith("#")))
+    return {name: [float(r[i]) if r[i] else float("nan") for r in rows[1:]] for i, name in enumerate(rows[0])}
+
+
+runs, docs = sys.argv[1], sys.argv[2]
+results = []
+for summary in sorted(glob.glob(os.path.join(runs, "*", "summary.csv"))):
+    name = os.path.basename(os.path.dirname(summary))
+    coupling, solid, res = name.split("_")
+    s = read(summary)
+    results.append(dict(coupling=coupling, solid=solid, res=int(res), dir=os.path.dirname(summary),
+                        **{k: v[0] for k, v in s.items()}))
+results.sort(key=lambda r: (r["coupling"], r["solid"], r["res"]))
+
+print("| coupling | solid | A/dp | particles | wall time (s) | reached t (s) | RMS dx (mm) | RMS dy (mm) "
+      "| max stretch | fluid inside gate (max) | blow-up |")
+print("|---|---|---|---|---|---|---|---|---|---|---|")
+for r in results:
+    blew = "yes" if r["blew_up"] else "no"
+    dx = "n/a" if r["rms_dx"] != r["rms_dx"] else f"{1e3 * r['rms_dx']:.2f}"
+    dy = "n/a" if r["rms_dy"] != r["rms_dy"] else f"{1e3 * r['rms_dy']:.2f}"
+    print(f"| {r['coupling']} | {r['solid']} | {r['res']} | {int(r['particles'])} | {r['wall_s']:.0f} | "
+          f"{r['end_time']:.3f} | {dx} | {dy} | {r['max_stretch']:.2f} | {int(r['fluid_inside_max'])} | {blew} |")
+
+os.makedirs(os.path.join(docs, "img"), exist_ok=True)
+markers = {"repulsive": "o", "interface": "s", "stress": "^"}
+colors = {"tl": "tab:blue", "ul": "tab:orange"}
+fig, axes = plt.subplots(1, 2, figsize=(11, 4))
+for ax, key, ref in ((axes[0], "rms_dx", 3.9), (axes[1], "rms_dy", 1.8)):
+    for r in results:
+        if r[key] == r[key]:
+            ax.loglog(r["wall_s"], 1e3 * r[key], markers[r["coupling"]], color=colors[r["solid"]],
+                      mfc="none" if r["blew_up"] else colors[r["solid"]], ms=5 + r["res"] / 20)
+            ax.annotate(str(r["res"]), (r["wall_s"], 1e3 * r[key]), fontsize=6)
+    ax.axhline(ref, color="k", ls="--", lw=1, label=f"Antoci 2007 SPH ({ref} mm)")
+    ax.set_xlabel("wall time for 0.4 s, 2 threads (s)")
+    ax.set_ylabel(f"RMS error {key[-2:]} (mm)")
+    ax.grid(alpha=0.3, which="both")
+for c, m in markers.items():
+    axes[0].plot([], [], m, color="gray", label=c)
+for s, col in colors.items():
+    axes[0].plot([], [], "o", color=col, label=f"solid {s}")
+axes[0].plot([], [], "o", mfc="none", color="gray", label="stopped (blow-up / break)")
+axes[0].legend(fontsize=7)
+fig.suptitle("Antoci gate: error against cost (label = A/dp)")
+fig.tight_layout()
+fig.savefig(os.path.join(docs, "img", "coupling_error_vs_time.png"), dpi=120)
+
+fig, axes = plt.subplots(1, 2, figsize=(11, 4))
+for r in results:
+    if r["res"] != 80:
+        continue
+    tip = read(os.path.join(r["dir"], "gate_tip.csv"))
+    for ax, key in ((axes[0], "dx"), (axes[1], "dy")):
+        ax.plot(tip["t"], [1e3 * v for v in tip[key]], "-" if r["solid"] == "tl" else "--",
+                label=f"{r['coupling']} / {r['solid']}")
+for ax, key in ((axes[0], "dx"), (axes[1], "dy")):
+    exp = read(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data",
+                            "antoci2007_gate_tip_experiment.csv"))
+    ax.plot(exp["t"], [1e3 * v for v in exp[key]], "ks", label="experiment")
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel(f"{key} (mm)")
+    ax.grid(alpha=0.3)
+axes[0].legend(fontsize=7)
+fig.tight_layout()
+fig.savefig(os.path.join(docs, "img", "coupling_tip_curves.png"), dpi=120)
