@@ -7,6 +7,9 @@
 // the equal and opposite reaction to the fluid particles (and, if it treats solid particles as part of the fluid's
 // continuity equation, their contribution to density_rate). Every coupling of sphfsi conserves the linear momentum
 // of the fluid-solid pair to round-off: the reaction is computed from the same pair terms as the action.
+// A coupling whose pair forces are stiffer than the fluid may also provide
+//   template <class System, class Solid> T stable_time_step(const System&, const Solid&) const;
+// (without the CFL factor); CoupledBody then limits the fluid step by it.
 // CoupledBody<Coupling, Solid> (coupling/coupled_body.hpp) turns a coupling and a SolidModel into one ParticleModel.
 #pragma once
 

@@ -30,9 +30,13 @@ class CoupledBody {
     coupling_.apply(system, solid_, time);
   }
 
+  /// The solid's limit (infinite when it sub-cycles) and, if the coupling has one, the coupling's.
   template <class System>
   typename System::scalar_type stable_time_step(const System& system) const {
-    return solid_.stable_time_step(system);
+    auto dt = solid_.stable_time_step(system);
+    if constexpr (requires { coupling_.stable_time_step(system, solid_); })
+      dt = std::min(dt, coupling_.stable_time_step(system, solid_));
+    return dt;
   }
 
   template <class System>

@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace sphfsi {
 
@@ -28,6 +29,19 @@ struct StressContinuity {
   void validate() const {
     require_in_range("StressContinuity::artificial_viscosity (alpha)", artificial_viscosity, T(0), T(5));
     require_in_range("StressContinuity::xsph (epsilon)", xsph, T(0), T(0.999));
+  }
+
+  /// The fluid particles next to the solid feel the solid's stress directly, so the fluid step must resolve the
+  /// solid's sound speed there: h / (c_solid + c_fluid) over the solid's particles (without the CFL factor).
+  template <class System, class Solid>
+  T stable_time_step(const System& system, const Solid& solid) const {
+    const auto& p = system.particles();
+    T dt = std::numeric_limits<T>::infinity();
+    const T c_fluid = system.eos().reference_sound_speed();
+    const T c_solid = solid.material().p_wave_speed();
+    for (const std::uint32_t id : solid.particle_ids())
+      dt = std::min(dt, p.smoothing_length[p.slot_of_id(id)] / (c_solid + c_fluid));
+    return dt;
   }
 
   template <class System, class Solid>
