@@ -1,27 +1,55 @@
-// sphfsi: umbrella header. Include single headers instead to keep compile times down.
+// sphfsi: umbrella header: every public header of the library. Include single headers instead to keep compile
+// times down.
 #pragma once
 
+#include <sphfsi/analysis/vegetation_drag.hpp>
+#include <sphfsi/analysis/zero_crossing.hpp>
+#include <sphfsi/boundary/repulsive_force.hpp>
 #include <sphfsi/core/domain.hpp>
 #include <sphfsi/core/error.hpp>
 #include <sphfsi/core/parallel.hpp>
 #include <sphfsi/core/particle_set.hpp>
 #include <sphfsi/core/particle_system.hpp>
 #include <sphfsi/core/types.hpp>
+#include <sphfsi/coupling/concepts.hpp>
+#include <sphfsi/coupling/coupled_body.hpp>
+#include <sphfsi/coupling/interface_pressure.hpp>
+#include <sphfsi/coupling/repulsive_force.hpp>
+#include <sphfsi/coupling/solid_surface.hpp>
+#include <sphfsi/coupling/stress_continuity.hpp>
+#include <sphfsi/eos/concepts.hpp>
 #include <sphfsi/eos/linear.hpp>
 #include <sphfsi/eos/tait.hpp>
 #include <sphfsi/fluid/wcsph.hpp>
+#include <sphfsi/integrators/concepts.hpp>
 #include <sphfsi/integrators/predictor_corrector.hpp>
 #include <sphfsi/integrators/simulation.hpp>
 #include <sphfsi/integrators/symplectic.hpp>
+#include <sphfsi/io/checkpoint.hpp>
+#include <sphfsi/io/command_line.hpp>
+#include <sphfsi/io/csv.hpp>
+#include <sphfsi/io/guarded_run.hpp>
+#include <sphfsi/io/progress.hpp>
+#include <sphfsi/io/vtk_writer.hpp>
+#include <sphfsi/kernel/concepts.hpp>
 #include <sphfsi/kernel/cubic_spline.hpp>
 #include <sphfsi/kernel/gaussian.hpp>
 #include <sphfsi/kernel/quintic_spline.hpp>
 #include <sphfsi/kernel/wendland_c2.hpp>
 #include <sphfsi/neighbors/cell_list.hpp>
+#include <sphfsi/scenes/antoci_gate.hpp>
 #include <sphfsi/scenes/builders.hpp>
+#include <sphfsi/scenes/dam_break.hpp>
+#include <sphfsi/scenes/gate_tip_comparison.hpp>
 #include <sphfsi/scenes/solid_builders.hpp>
+#include <sphfsi/scenes/surge_front_comparison.hpp>
+#include <sphfsi/scenes/wave_flume.hpp>
 #include <sphfsi/solid/body.hpp>
 #include <sphfsi/solid/concepts.hpp>
 #include <sphfsi/solid/elastic_material.hpp>
 #include <sphfsi/solid/total_lagrangian.hpp>
 #include <sphfsi/solid/updated_lagrangian.hpp>
+#include <sphfsi/waves/damping_zone.hpp>
+#include <sphfsi/waves/gauges.hpp>
+#include <sphfsi/waves/linear_theory.hpp>
+#include <sphfsi/waves/wavemaker.hpp>
