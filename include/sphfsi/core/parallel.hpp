@@ -37,6 +37,23 @@ void parallel_for(std::size_t n, Body&& body) {
 #endif
 }
 
+/// Splits [0, n) into one contiguous chunk per thread, in index order, and calls body(begin, end, thread) once per
+/// chunk in parallel (thread < thread_count()). For loops whose iterations also write to a few later indices: each
+/// chunk knows its bounds and can set aside what it would write beyond `end`.
+template <class Body>
+void parallel_chunks(std::size_t n, Body&& body) {
+#if defined(_OPENMP)
+#pragma omp parallel
+  {
+    const auto threads = static_cast<std::size_t>(omp_get_num_threads());
+    const auto thread = static_cast<std::size_t>(omp_get_thread_num());
+    body(n * thread / threads, n * (thread + 1) / threads, thread);
+  }
+#else
+  body(std::size_t(0), n, std::size_t(0));
+#endif
+}
+
 /// Parallel minimum reduction of f(i) over [0, n); returns init when n == 0.
 template <class T, class F>
 T parallel_min(std::size_t n, T init, F&& f) {

@@ -22,6 +22,7 @@
 #include <sphfsi/neighbors/cell_list.hpp>
 
 #include <cmath>
+#include <limits>
 
 namespace sphfsi {
 
@@ -70,28 +71,36 @@ class ParticleSystem {
   /// Re-sorts particles by cell and rebuilds the neighbour index. Call after particles moved.
   void update_neighbors(T time = T(0)) {
     check_state(time);
-    T h_max = T(0);
-    for (T h : particles_.smoothing_length) h_max = std::max(h_max, h);
+    T h_max = T(0), h_min = std::numeric_limits<T>::max();
+    for (T h : particles_.smoothing_length) {
+      h_max = std::max(h_max, h);
+      h_min = std::min(h_min, h);
+    }
+    uniform_h_ = h_max > T(0) && h_min == h_max;
     if (h_max <= T(0)) h_max = T(1);
+    h_uniform_ = h_max;
     cells_.build(particles_, domain_, static_cast<T>(Kernel::support) * h_max);
   }
+
+  /// Whether every particle had the same smoothing length at the last update_neighbors().
+  bool uniform_smoothing_length() const noexcept { return uniform_h_; }
 
   /// Calls f(j, dx, r, h_ab) for every particle j != i with r = |x_i - x_j| < support * h_ab.
   template <class F>
   void for_each_neighbor(std::size_t i, F&& f) const {
-    const Vector xi = particles_.position[i];
-    const T hi = particles_.smoothing_length[i];
-    const T* h = particles_.smoothing_length.data();
-    const Vector* x = particles_.position.data();
-    constexpr T support = static_cast<T>(Kernel::support);
-    cells_.for_each_candidate(i, [&](std::size_t j) {
-      const Vector dx = xi - x[j];
-      const T r2 = dx.squaredNorm();
-      const T h_ab = T(0.5) * (hi + h[j]);
-      const T radius = support * h_ab;
-      if (r2 < radius * radius && j != i) f(j, dx, std::sqrt(r2), h_ab);
-    });
+    visit_neighbors(i, f, [this](std::size_t a, auto&& g) { cells_.for_each_candidate(a, g); });
   }
+
+  /// Calls f(j, dx, r, h_ab) like for_each_neighbor, but only for the neighbours j > i of the half stencil: over
+  /// all i every neighbour pair is visited exactly once (pair forces evaluated once, applied to both particles).
+  /// Every j lies in [i + 1, neighbor_once_end(i)).
+  template <class F>
+  void for_each_neighbor_once(std::size_t i, F&& f) const {
+    visit_neighbors(i, f, [this](std::size_t a, auto&& g) { cells_.for_each_candidate_once(a, g); });
+  }
+
+  /// One past the largest slot for_each_neighbor_once(i, f) can visit.
+  std::size_t neighbor_once_end(std::size_t i) const { return cells_.candidate_once_end(i); }
 
   /// Recomputes pressure and sound speed of fluid and wall particles from their density with the fluid EOS.
   /// Solid particles keep the pressure their solid model wrote.
@@ -107,6 +116,35 @@ class ParticleSystem {
   const CellList<Dim, T>& cells() const noexcept { return cells_; }
 
  private:
+  // Filters the candidates that `candidates(i, g)` passes to g by distance and calls f(j, dx, r, h_ab). With one
+  // smoothing length for all particles h_ab is a loop constant (h_ab = (h + h) / 2 = h exactly), which lets the
+  // compiler hoist the kernel's h-dependent factors out of the pair loop.
+  template <class F, class Candidates>
+  void visit_neighbors(std::size_t i, F& f, Candidates&& candidates) const {
+    const Vector xi = particles_.position[i];
+    const Vector* x = particles_.position.data();
+    constexpr T support = static_cast<T>(Kernel::support);
+    if (uniform_h_) {
+      const T h = h_uniform_;
+      const T radius2 = (support * h) * (support * h);
+      candidates(i, [&, h, radius2](std::size_t j) {
+        const Vector dx = xi - x[j];
+        const T r2 = dx.squaredNorm();
+        if (r2 < radius2 && j != i) f(j, dx, std::sqrt(r2), h);
+      });
+    } else {
+      const T hi = particles_.smoothing_length[i];
+      const T* hs = particles_.smoothing_length.data();
+      candidates(i, [&](std::size_t j) {
+        const Vector dx = xi - x[j];
+        const T r2 = dx.squaredNorm();
+        const T h_ab = T(0.5) * (hi + hs[j]);
+        const T radius = support * h_ab;
+        if (r2 < radius * radius && j != i) f(j, dx, std::sqrt(r2), h_ab);
+      });
+    }
+  }
+
   static std::string fmt_vec(const Vector& v) {
     std::string s;
     for (int d = 0; d < Dim; ++d) s += (d ? ", " : "") + fmt::format("{:.6g}", v[d]);
@@ -118,6 +156,8 @@ class ParticleSystem {
   Kernel kernel_;
   Particles particles_;
   CellList<Dim, T> cells_;
+  T h_uniform_{1};          // the smoothing length when uniform_h_, m
+  bool uniform_h_{false};   // all smoothing lengths equal at the last update_neighbors()
 };
 
 }  // namespace sphfsi

@@ -88,82 +88,44 @@ class WcsphFluid {
   void restore_signal_speeds(std::vector<T> speeds) { signal_speed_ = std::move(speeds); }
 
   /// Overwrites acceleration, density_rate and xsph_velocity of fluid and wall particles
-  /// (pressure and sound speed must be current: System::update_pressure()).
+  /// (pressure and sound speed must be current: System::update_pressure(), neighbours too:
+  /// System::update_neighbors()).
+  ///
+  /// Each neighbour pair is evaluated once (ParticleSystem::for_each_neighbor_once) and applied to both particles:
+  /// W, grad W and the pair terms are symmetric (grad_b W = -grad_a W), so the pair's contributions to a and b
+  /// differ only by the partner's mass and sign. Threads take contiguous slot ranges; what a pair adds to a slot
+  /// beyond its thread's range goes to that thread's spill buffer, added after the parallel loop.
   void compute_rates(System& system) {
     auto& p = system.particles();
-    const auto& kernel = system.kernel();
-    const T rho0 = system.eos().reference_density();
-    const T c0 = system.eos().reference_sound_speed();
+    const std::size_t n = p.size();
+    signal_speed_.assign(n, T(0));
+    pressure_term_.resize(n);
+    volume_.resize(n);
+    parallel_for(n, [&](std::size_t a) {
+      p.acceleration[a] = Vector::Zero();
+      p.density_rate[a] = T(0);
+      p.xsph_velocity[a] = Vector::Zero();
+      pressure_term_[a] = p.pressure[a] / (p.density[a] * p.density[a]);  // p / rho^2, Pa m^6/kg^2
+      volume_[a] = p.mass[a] / p.density[a];                               // m^3 (m^2 in 2D)
+    });
+    const auto threads = static_cast<std::size_t>(std::max(1, thread_count()));
+    if (spills_.size() < threads) spills_.resize(threads);
+    parallel_chunks(n, [&](std::size_t begin, std::size_t end, std::size_t thread) {
+      accumulate_pairs(system, begin, end, spills_[thread]);
+    });
+    for (Spill& spill : spills_) {
+      for (std::size_t k = 0; k < spill.density_rate.size(); ++k) {
+        const std::size_t b = spill.begin + k;
+        p.acceleration[b] += spill.acceleration[k];
+        p.density_rate[b] += spill.density_rate[k];
+        p.xsph_velocity[b] += spill.xsph_velocity[k];
+        signal_speed_[b] = std::max(signal_speed_[b], spill.signal_speed[k]);
+      }
+      spill.resize(0);
+    }
     const Vector g = params_.gravity;
-    const T alpha = params_.artificial_viscosity;
-    const T delta = params_.density_diffusion;
-    const T eps_xsph = params_.xsph;
-    const T nu = params_.kinematic_viscosity;
-    const bool dynamic_walls = params_.walls == WallModel::dynamic;
-    const int up = params_.repulsive.vertical_axis;
-    signal_speed_.assign(p.size(), T(0));
-
-    parallel_for(p.size(), [&](std::size_t a) {
-      const Kind ka = p.kind[a];
-      if (ka == Kind::solid) {  // external (fluid-on-solid) forces start from zero; couplings add to them
-        p.acceleration[a] = Vector::Zero();
-        p.density_rate[a] = T(0);
-        p.xsph_velocity[a] = Vector::Zero();
-        return;
-      }
-      Vector acc = Vector::Zero(), xsph = Vector::Zero();
-      T drho = T(0), mu_max = T(0);
-      const Vector xa = p.position[a], va = p.velocity[a];
-      const T rho_a = p.density[a], pa = p.pressure[a], ca = p.sound_speed[a];
-      const T pa_over_rho2 = pa / (rho_a * rho_a);
-
-      if (ka == Kind::wall) {
-        if (dynamic_walls) {
-          system.for_each_neighbor(a, [&](std::size_t b, const Vector& dx, T r, T h) {
-            if (p.kind[b] != Kind::fluid) return;
-            drho += p.mass[b] * (va - p.velocity[b]).dot(kernel_gradient(kernel, dx, r, h));
-          });
-        }
-        p.density_rate[a] = drho;
-        p.acceleration[a] = Vector::Zero();
-        p.xsph_velocity[a] = Vector::Zero();
-        return;
-      }
-
-      system.for_each_neighbor(a, [&](std::size_t b, const Vector& dx, T r, T h) {
-        const Kind kb = p.kind[b];
-        if (kb == Kind::solid) return;
-        const Vector vab = va - p.velocity[b];
-        if (kb == Kind::wall && !dynamic_walls) {
-          acc += repulsive_force<Dim, T>(dx, vab, p.normal[b], h, c0, xa[up] - params_.repulsive.water_level,
-                                         params_.repulsive);
-          return;
-        }
-        const Vector grad = kernel_gradient(kernel, dx, r, h);
-        const T mb = p.mass[b], rho_b = p.density[b];
-        const T eta2 = T(0.01) * h * h;
-        const T vr = vab.dot(dx);
-        const T mu = h * vr / (r * r + eta2);
-        mu_max = std::max(mu_max, std::abs(mu));
-        drho += mb * vab.dot(grad);
-        T pi_ab = T(0);
-        if (vr < T(0)) pi_ab = -alpha * T(0.5) * (ca + p.sound_speed[b]) * mu / (T(0.5) * (rho_a + rho_b));
-        acc -= mb * (pa_over_rho2 + p.pressure[b] / (rho_b * rho_b) + pi_ab) * grad;
-        if (nu > T(0)) acc += (mb * nu * (rho_a + rho_b) / (rho_a * rho_b) * dx.dot(grad) / (r * r + eta2)) * vab;
-        if (kb == Kind::fluid) {
-          if (delta > T(0)) {
-            const T hydrostatic = rho0 * g.dot(dx) / (c0 * c0);
-            drho += delta * h * c0 * (mb / rho_b) * T(2) * ((rho_a - rho_b) - hydrostatic) * dx.dot(grad) /
-                    (r * r + eta2);
-          }
-          if (eps_xsph > T(0))
-            xsph -= (eps_xsph * mb / (T(0.5) * (rho_a + rho_b)) * kernel.value(r, h)) * vab;
-        }
-      });
-      p.acceleration[a] = acc + g;
-      p.density_rate[a] = drho;
-      p.xsph_velocity[a] = xsph;
-      signal_speed_[a] = mu_max;
+    parallel_for(n, [&](std::size_t a) {
+      if (p.kind[a] == Kind::fluid) p.acceleration[a] += g;
     });
   }
 
@@ -186,8 +148,162 @@ class WcsphFluid {
   }
 
  private:
+  // What one thread's pairs add to slots beyond its own range [.., begin): slot begin + k at index k.
+  struct Spill {
+    std::size_t begin = 0;
+    std::vector<Vector> acceleration, xsph_velocity;
+    std::vector<T> density_rate, signal_speed;
+    void resize(std::size_t count) {  // and zero; capacity is kept, so the time loop does not allocate
+      acceleration.assign(count, Vector::Zero());
+      xsph_velocity.assign(count, Vector::Zero());
+      density_rate.assign(count, T(0));
+      signal_speed.assign(count, T(0));
+    }
+  };
+
+  // Where the partner's share of a pair goes: straight into the particle arrays, or, with `spilling`, into the
+  // spill buffer for partners at or beyond `limit` (another thread's slots).
+  template <bool spilling>
+  struct PartnerSink {
+    Vector* acceleration;
+    T* density_rate;
+    Vector* xsph_velocity;
+    T* signal_speed;
+    Spill* spill;
+    std::size_t limit;
+
+    void add_acceleration(std::size_t b, const Vector& v) const {
+      if (spilling && b >= limit) spill->acceleration[b - limit] += v;
+      else acceleration[b] += v;
+    }
+    void add_density_rate(std::size_t b, T v) const {
+      if (spilling && b >= limit) spill->density_rate[b - limit] += v;
+      else density_rate[b] += v;
+    }
+    void add_xsph(std::size_t b, const Vector& v) const {
+      if (spilling && b >= limit) spill->xsph_velocity[b - limit] += v;
+      else xsph_velocity[b] += v;
+    }
+    void raise_signal_speed(std::size_t b, T v) const {
+      T& s = (spilling && b >= limit) ? spill->signal_speed[b - limit] : signal_speed[b];
+      s = std::max(s, v);
+    }
+  };
+
+  // Pairs (a, b > a) for the slots a in [begin, end) of one thread.
+  void accumulate_pairs(System& system, std::size_t begin, std::size_t end, Spill& spill) {
+    auto& p = system.particles();
+    std::size_t reach = end;
+    for (std::size_t a = begin; a < end; ++a) reach = std::max(reach, system.neighbor_once_end(a));
+    spill.begin = end;
+    spill.resize(reach - end);
+    const PartnerSink<false> direct{p.acceleration.data(), p.density_rate.data(), p.xsph_velocity.data(),
+                                    signal_speed_.data(), &spill, end};
+    const PartnerSink<true> spilling{p.acceleration.data(), p.density_rate.data(), p.xsph_velocity.data(),
+                                     signal_speed_.data(), &spill, end};
+    for (std::size_t a = begin; a < end; ++a) {
+      if (system.neighbor_once_end(a) <= end) accumulate_particle(system, a, direct);
+      else accumulate_particle(system, a, spilling);
+    }
+  }
+
+  // All pairs (a, b) with b > a in a's half stencil: a's share is summed locally, b's share goes to `partner`.
+  template <class Sink>
+  void accumulate_particle(System& system, std::size_t a, const Sink& partner) {
+    auto& p = system.particles();
+    const Kind ka = p.kind[a];
+    if (ka == Kind::solid) return;  // solids: fluid-solid pairs belong to the coupling policies
+    const auto& kernel = system.kernel();
+    const T rho0 = system.eos().reference_density();
+    const T c0 = system.eos().reference_sound_speed();
+    const Vector g = params_.gravity;
+    const T alpha = params_.artificial_viscosity;
+    const T delta = params_.density_diffusion;
+    const T eps_xsph = params_.xsph;
+    const T nu = params_.kinematic_viscosity;
+    const bool dynamic_walls = params_.walls == WallModel::dynamic;
+    const int up = params_.repulsive.vertical_axis;
+    const T water_level = params_.repulsive.water_level;
+    const Kind* kind = p.kind.data();
+    const Vector* x = p.position.data();
+    const Vector* v = p.velocity.data();
+    const T* mass = p.mass.data();
+    const T* rho = p.density.data();
+    const T* c = p.sound_speed.data();
+    const T* pressure_term = pressure_term_.data();
+    const T* volume = volume_.data();
+
+    const bool fluid_a = ka == Kind::fluid;
+    const Vector xa = x[a], va = v[a];
+    const T rho_a = rho[a], ca = c[a], ma = mass[a], pa = pressure_term[a], vol_a = volume[a];
+    Vector acc = Vector::Zero(), xsph = Vector::Zero();
+    T drho = T(0), mu_max = T(0);
+
+    system.for_each_neighbor_once(a, [&](std::size_t b, const Vector& dx, T r, T h) {
+      const Kind kb = kind[b];
+      const bool fluid_b = kb == Kind::fluid;
+      if (kb == Kind::solid || !(fluid_a || fluid_b)) return;  // wall-wall pairs do not interact
+      const Vector vab = va - v[b];
+      if (!dynamic_walls && !(fluid_a && fluid_b)) {  // repulsive wall: pushes the fluid particle only
+        if (fluid_a)
+          acc += repulsive_force<Dim, T>(dx, vab, p.normal[b], h, c0, xa[up] - water_level, params_.repulsive);
+        else
+          partner.add_acceleration(b, repulsive_force<Dim, T>(Vector(-dx), Vector(-vab), p.normal[a], h, c0,
+                                                              x[b][up] - water_level, params_.repulsive));
+        return;
+      }
+      // grad_a W = dx dW/dr / r, so v_ab . grad_a W = (dW/dr / r) v_ab . dx and dx . grad_a W = (dW/dr / r) r^2.
+      const T grad_factor = r > T(0) ? kernel.derivative(r, h) / r : T(0);  // 1/m^(Dim+2)
+      const Vector grad = grad_factor * dx;
+      const T vr = vab.dot(dx);
+      const T r2 = r * r;
+      const T inverse_distance2 = T(1) / (r2 + T(0.01) * h * h);  // 1 / (r^2 + eta^2)
+      const T mu = h * vr * inverse_distance2;
+      const T continuity = grad_factor * vr;  // v_ab . grad_a W
+      drho += mass[b] * continuity;
+      partner.add_density_rate(b, ma * continuity);
+      const T rho_b = rho[b];
+      const T pi_ab = vr < T(0) ? -alpha * (ca + c[b]) * mu / (rho_a + rho_b) : T(0);
+      const T force = pa + pressure_term[b] + pi_ab;
+      const T laminar = nu > T(0) ? nu * (rho_a + rho_b) / (rho_a * rho_b) * grad_factor * r2 * inverse_distance2
+                                  : T(0);
+      if (fluid_a) {
+        acc -= (mass[b] * force) * grad;
+        if (nu > T(0)) acc += (mass[b] * laminar) * vab;
+        mu_max = std::max(mu_max, std::abs(mu));
+      }
+      if (fluid_b) {
+        Vector acc_b = (ma * force) * grad;
+        if (nu > T(0)) acc_b -= (ma * laminar) * vab;
+        partner.add_acceleration(b, acc_b);
+        partner.raise_signal_speed(b, std::abs(mu));
+      }
+      if (fluid_a && fluid_b) {
+        if (delta > T(0)) {
+          const T hydrostatic = rho0 * g.dot(dx) / (c0 * c0);
+          const T diffusion =
+              delta * h * c0 * T(2) * ((rho_a - rho_b) - hydrostatic) * grad_factor * r2 * inverse_distance2;
+          drho += volume[b] * diffusion;
+          partner.add_density_rate(b, -vol_a * diffusion);
+        }
+        if (eps_xsph > T(0)) {
+          const T w = eps_xsph * kernel.value(r, h) / (T(0.5) * (rho_a + rho_b));
+          xsph -= (mass[b] * w) * vab;
+          partner.add_xsph(b, (ma * w) * vab);
+        }
+      }
+    });
+    p.acceleration[a] += acc;
+    p.density_rate[a] += drho;
+    p.xsph_velocity[a] += xsph;
+    signal_speed_[a] = std::max(signal_speed_[a], mu_max);
+  }
+
   FluidParameters<Dim, T> params_;
   std::vector<T> signal_speed_;
+  std::vector<T> pressure_term_;  // p / rho^2 per slot, Pa m^6/kg^2
+  std::vector<T> volume_;         // m / rho per slot
+  std::vector<Spill> spills_;     // one per thread
 };
 
 }  // namespace sphfsi

@@ -61,7 +61,9 @@ class CellList {
     cursor_.assign(cell_start_.begin(), cell_start_.end() - 1);
     for (std::size_t i = 0; i < n; ++i) order_[cursor_[cell_of_[i]]++] = static_cast<std::uint32_t>(i);
     particles.permute(order_);
-    for (std::size_t i = 0; i < n; ++i) cell_of_[i] = cell_index(particles.position[i]);
+    // Slots are now in cell order: the cell of slot i is the cell its particle was sorted into.
+    for (std::size_t c = 0; c < total; ++c)
+      for (std::uint32_t i = cell_start_[c]; i < cell_start_[c + 1]; ++i) cell_of_[i] = static_cast<std::uint32_t>(c);
   }
 
   /// Calls f(j) for every particle j in the 3^D cells around particle i's cell (i itself included).
@@ -84,6 +86,38 @@ class CellList {
           for (std::uint32_t j = begin; j < end; ++j) f(static_cast<std::size_t>(j));
         }
     }
+  }
+
+  /// Calls f(j) for every particle j > i of the half stencil of particle i's cell: the rest of i's own stencil
+  /// row, the row above (and in 3D the whole layer above). Over all i every pair of particles in neighbouring
+  /// cells is visited exactly once, so pair forces can be evaluated once and applied to both particles.
+  template <class F>
+  void for_each_candidate_once(std::size_t i, F&& f) const {
+    const std::uint32_t c = cell_of_[i];
+    const std::uint32_t own_end = cell_start_[c + 2];
+    for (std::uint32_t j = static_cast<std::uint32_t>(i) + 1; j < own_end; ++j) f(static_cast<std::size_t>(j));
+    const std::int64_t nx = cells_[0];
+    if constexpr (Dim == 2) {
+      const std::int64_t row = static_cast<std::int64_t>(c) + nx;
+      const std::uint32_t begin = cell_start_[row - 1], end = cell_start_[row + 2];
+      for (std::uint32_t j = begin; j < end; ++j) f(static_cast<std::size_t>(j));
+    } else {
+      const std::int64_t nxy = std::int64_t(cells_[0]) * cells_[1];
+      // row (dy = +1, dz = 0), then the three rows of the layer dz = +1
+      const std::int64_t rows[4] = {nx, nxy - nx, nxy, nxy + nx};
+      for (std::int64_t offset : rows) {
+        const std::int64_t row = static_cast<std::int64_t>(c) + offset;
+        const std::uint32_t begin = cell_start_[row - 1], end = cell_start_[row + 2];
+        for (std::uint32_t j = begin; j < end; ++j) f(static_cast<std::size_t>(j));
+      }
+    }
+  }
+
+  /// One past the largest slot for_each_candidate_once(i, f) can visit (the cells are in slot order).
+  std::size_t candidate_once_end(std::size_t i) const {
+    const std::int64_t c = cell_of_[i], nx = cells_[0];
+    const std::int64_t last_row = Dim == 2 ? c + nx : c + nx + std::int64_t(cells_[0]) * cells_[1];
+    return cell_start_[last_row + 2];
   }
 
   T cell_size() const noexcept { return cell_size_; }
