@@ -52,6 +52,9 @@ struct FluidParameters {
   T kinematic_viscosity{T(0)};              ///< laminar viscosity nu, m^2/s (0: none)
   WallModel walls{WallModel::dynamic};
   RepulsiveForceParameters<T> repulsive{};  ///< used when walls == repulsive
+  /// Fluid pressure floor, Pa (-inf: none). 0 stops spray clusters from collapsing under negative pressure
+  /// (tensile instability, Swegle et al. 1995): water in a thin jet cannot sustain tension.
+  T minimum_pressure{-std::numeric_limits<T>::infinity()};
 
   static Vec<Dim, T> default_gravity() {
     Vec<Dim, T> g = Vec<Dim, T>::Zero();
@@ -65,6 +68,9 @@ struct FluidParameters {
     require_in_range("FluidParameters::density_diffusion (delta)", density_diffusion, T(0), T(1));
     require_in_range("FluidParameters::xsph (epsilon)", xsph, T(0), T(0.999));
     require_non_negative("FluidParameters::kinematic_viscosity (m^2/s)", kinematic_viscosity);
+    if (!(minimum_pressure <= T(0)))
+      throw InputError(fmt::format("FluidParameters::minimum_pressure = {} Pa is invalid: valid range is [-inf, 0]",
+                                   minimum_pressure));
     if (walls == WallModel::repulsive)
       require_positive("FluidParameters::repulsive.boundary_spacing (m)", repulsive.boundary_spacing);
   }
@@ -94,7 +100,7 @@ class WcsphFluid {
   /// Each neighbour pair is evaluated once (ParticleSystem::for_each_neighbor_once) and applied to both particles:
   /// W, grad W and the pair terms are symmetric (grad_b W = -grad_a W), so the pair's contributions to a and b
   /// differ only by the partner's mass and sign. Threads take contiguous slot ranges; what a pair adds to a slot
-  /// beyond its thread's range goes to that thread's spill buffer, added after the parallel loop.
+  /// beyond its range goes to that range's spill buffer, added after the parallel loop.
   void compute_rates(System& system) {
     auto& p = system.particles();
     const std::size_t n = p.size();
@@ -108,10 +114,13 @@ class WcsphFluid {
       pressure_term_[a] = p.pressure[a] / (p.density[a] * p.density[a]);  // p / rho^2, Pa m^6/kg^2
       volume_[a] = p.mass[a] / p.density[a];                               // m^3 (m^2 in 2D)
     });
-    const auto threads = static_cast<std::size_t>(std::max(1, thread_count()));
-    if (spills_.size() < threads) spills_.resize(threads);
-    parallel_chunks(n, [&](std::size_t begin, std::size_t end, std::size_t thread) {
-      accumulate_pairs(system, begin, end, spills_[thread]);
+    // A few slot ranges per thread, handed out dynamically: wall particles cost less than fluid ones, and on a
+    // shared machine a thread may be descheduled for a while.
+    const std::size_t threads = static_cast<std::size_t>(std::max(1, thread_count()));
+    const std::size_t chunks = threads == 1 ? 1 : std::min<std::size_t>(4 * threads, std::max<std::size_t>(1, n / 128));
+    if (spills_.size() < chunks) spills_.resize(chunks);
+    parallel_chunks(n, chunks, [&](std::size_t begin, std::size_t end, std::size_t chunk) {
+      accumulate_pairs(system, begin, end, spills_[chunk]);
     });
     for (Spill& spill : spills_) {
       for (std::size_t k = 0; k < spill.density_rate.size(); ++k) {
@@ -148,7 +157,7 @@ class WcsphFluid {
   }
 
  private:
-  // What one thread's pairs add to slots beyond its own range [.., begin): slot begin + k at index k.
+  // What the pairs of one slot range add to slots beyond it (other ranges): slot begin + k at index k.
   struct Spill {
     std::size_t begin = 0;
     std::vector<Vector> acceleration, xsph_velocity;
@@ -162,7 +171,7 @@ class WcsphFluid {
   };
 
   // Where the partner's share of a pair goes: straight into the particle arrays, or, with `spilling`, into the
-  // spill buffer for partners at or beyond `limit` (another thread's slots).
+  // spill buffer for partners at or beyond `limit` (another range's slots).
   template <bool spilling>
   struct PartnerSink {
     Vector* acceleration;
@@ -190,7 +199,7 @@ class WcsphFluid {
     }
   };
 
-  // Pairs (a, b > a) for the slots a in [begin, end) of one thread.
+  // Pairs (a, b > a) for the slots a in [begin, end) of one range.
   void accumulate_pairs(System& system, std::size_t begin, std::size_t end, Spill& spill) {
     auto& p = system.particles();
     std::size_t reach = end;
@@ -303,7 +312,7 @@ class WcsphFluid {
   std::vector<T> signal_speed_;
   std::vector<T> pressure_term_;  // p / rho^2 per slot, Pa m^6/kg^2
   std::vector<T> volume_;         // m / rho per slot
-  std::vector<Spill> spills_;     // one per thread
+  std::vector<Spill> spills_;     // one per slot range
 };
 
 }  // namespace sphfsi

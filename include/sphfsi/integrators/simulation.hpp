@@ -152,6 +152,12 @@ class Simulation {
   void evaluate_rates(T t) {
     system_.update_neighbors(t);
     system_.update_pressure();
+    if (const T p_min = fluid_.parameters().minimum_pressure; p_min > -std::numeric_limits<T>::infinity()) {
+      auto& p = system_.particles();
+      parallel_for(p.size(), [&](std::size_t i) {
+        if (p.kind[i] == Kind::fluid) p.pressure[i] = std::max(p.pressure[i], p_min);
+      });
+    }
     fluid_.compute_rates(system_);
     std::apply([&](auto&... m) { (m.compute_rates(system_, t), ...); }, models_);
   }

@@ -76,6 +76,7 @@ struct AntociGate {
     FluidParameters<2, T> f;
     f.gravity = Vec<2, T>(0, -gravity);
     f.artificial_viscosity = T(0.02);
+    f.minimum_pressure = T(0);  // the jet under the gate breaks into spray: no tension in it
     return f;
   }
 };
