@@ -37,20 +37,22 @@ void parallel_for(std::size_t n, Body&& body) {
 #endif
 }
 
-/// Splits [0, n) into one contiguous chunk per thread, in index order, and calls body(begin, end, thread) once per
-/// chunk in parallel (thread < thread_count()). For loops whose iterations also write to a few later indices: each
-/// chunk knows its bounds and can set aside what it would write beyond `end`.
+/// Splits [0, n) into `chunks` contiguous ranges, in index order, and calls body(begin, end, chunk) once per range,
+/// the ranges shared out to the threads dynamically (whichever thread is free takes the next range, so cheap ranges
+/// or a thread descheduled by other work on the machine do not leave the others waiting). For loops whose iterations also write to a few later indices: each
+/// range knows its bounds and can set aside what it would write beyond `end`.
 template <class Body>
-void parallel_chunks(std::size_t n, Body&& body) {
+void parallel_chunks(std::size_t n, std::size_t chunks, Body&& body) {
+  if (chunks == 0) chunks = 1;
 #if defined(_OPENMP)
-#pragma omp parallel
-  {
-    const auto threads = static_cast<std::size_t>(omp_get_num_threads());
-    const auto thread = static_cast<std::size_t>(omp_get_thread_num());
-    body(n * thread / threads, n * (thread + 1) / threads, thread);
+  const auto count = static_cast<long long>(chunks);
+#pragma omp parallel for schedule(dynamic, 1)
+  for (long long c = 0; c < count; ++c) {
+    const auto k = static_cast<std::size_t>(c);
+    body(n * k / chunks, n * (k + 1) / chunks, k);
   }
 #else
-  body(std::size_t(0), n, std::size_t(0));
+  for (std::size_t k = 0; k < chunks; ++k) body(n * k / chunks, n * (k + 1) / chunks, k);
 #endif
 }
 
