@@ -28,7 +28,7 @@ namespace sphfsi {
 
 template <int Dim, Real T, class Kernel, class Eos>
   requires SpatialDimension<Dim> && SmoothingKernel<Kernel, T> && EquationOfState<Eos, T> &&
-           (Kernel::dimension == Dim)
+           KernelOfDimension<Kernel, Dim>
 class ParticleSystem {
  public:
   static constexpr int dimension = Dim;

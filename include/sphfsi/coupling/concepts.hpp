@@ -22,7 +22,7 @@ template <class C, class System, class Solid>
 concept FsiCoupling = std::is_trivially_copyable_v<C> &&
                       requires(const C& c, System& s, const Solid& solid, typename System::scalar_type t) {
                         { C::name } -> std::convertible_to<const char*>;
-                        { c.apply(s, solid, t) };
+                        c.apply(s, solid, t);
                       };
 
 }  // namespace sphfsi

@@ -19,9 +19,9 @@ namespace sphfsi {
 
 template <class M, class System>
 concept ParticleModel = requires(M& m, const M& cm, System& s, const System& cs, typename System::scalar_type t) {
-  { m.compute_rates(s, t) };
+  m.compute_rates(s, t);
   { cm.stable_time_step(cs) } -> std::convertible_to<typename System::scalar_type>;
-  { m.advance(s, t, t) };
+  m.advance(s, t, t);
 };
 
 }  // namespace sphfsi

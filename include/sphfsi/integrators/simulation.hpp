@@ -49,9 +49,12 @@ struct PrescribedKinematics {
   std::function<std::pair<Vec<Dim, T>, Vec<Dim, T>>(const Vec<Dim, T>&, T)> state;
 };
 
+// clang-format 14 writes the fold expression below as `...>&&...)`: keep it as written.
+// clang-format off
 template <class System, class Integrator, class... Models>
   requires(ParticleModel<Models, System> && ...)
 class Simulation {
+  // clang-format on
  public:
   static constexpr int Dim = System::dimension;
   using T = typename System::scalar_type;

@@ -358,7 +358,7 @@ class VtkSeriesWriter {
                               std::type_identity_t<std::span<const PointField<Dim, T>>> extra = {}) {
     require_finite("VtkSeriesWriter::write time (s)", time);
     const std::string file = fmt::format("{}_{:06d}.vtu", name_, entries_.size());
-    const std::filesystem::path path = directory_ / file;
+    std::filesystem::path path = directory_ / file;
     write_vtu(path, particles, time, encoding_, extra, &scratch_);
     entries_.push_back({time, file});
     write_collection();

@@ -25,6 +25,11 @@ concept SmoothingKernel = std::is_trivially_copyable_v<K> && std::is_default_con
                             { k.derivative(r, h) } -> std::same_as<T>;
                           };
 
+/// A kernel written for spatial dimension Dim (its normalisation depends on it). A named concept rather than a
+/// parenthesized expression in ParticleSystem's requires clause, which clang-format 14 cannot format.
+template <class K, int Dim>
+concept KernelOfDimension = (K::dimension == Dim);
+
 /// Gradient of W with respect to x_a, for dx = x_a - x_b and r = |dx|; zero at r = 0.
 template <class K, int Dim, class T>
   requires SmoothingKernel<K, T>

@@ -1,0 +1,38 @@
+# AddressSanitizer + UndefinedBehaviorSanitizer run of the core unit tests (issue 7, CI hardening).
+# A second, coarser unit-test executable, sphfsi_unit_tests_sanitized, built at -O1 -g with
+#   -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
+# from the unit-test files that exercise the core: kernels, equations of state, neighbour search, I/O (VTK, CSV,
+# checkpoints), couplings, solids and the robustness suite (validation, blow-ups, restart). Left out to keep the
+# compile time of CI sane: the wave-flume tests (test_waves.cpp, analysis on top of the same core loops) and the
+# one-definition-rule pair (test_odr*.cpp, a link-time check that the normal build already performs).
+# One CTest test, label `sanitizer`; it halts at the first error. The full suite under sanitizers is the `asan`
+# preset (cmake --workflow --preset asan).
+option(SPHFSI_SANITIZER_TESTS "Build and run the core unit tests under ASan + UBSan (test preset: ON)" OFF)
+if(NOT SPHFSI_SANITIZER_TESTS)
+  return()
+endif()
+if(NOT CMAKE_CXX_COMPILER_ID MATCHES "GNU|Clang")
+  message(WARNING "SPHFSI_SANITIZER_TESTS needs GCC or Clang (-fsanitize=address,undefined); not built")
+  return()
+endif()
+
+set(SPHFSI_SANITIZED_UNIT_SOURCES
+    test_kernels.cpp test_eos.cpp test_neighbors.cpp test_io.cpp test_couplings.cpp test_solids.cpp
+    test_robustness.cpp)
+list(TRANSFORM SPHFSI_SANITIZED_UNIT_SOURCES PREPEND ${CMAKE_CURRENT_LIST_DIR}/../unit/)
+add_executable(sphfsi_unit_tests_sanitized ${CMAKE_CURRENT_LIST_DIR}/../catch_main.cpp ${SPHFSI_SANITIZED_UNIT_SOURCES})
+target_link_libraries(sphfsi_unit_tests_sanitized PRIVATE sphfsi::sphfsi Catch2::Catch2)
+set(_sphfsi_sanitize -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
+# -O1 -g after the build type's flags, so it wins over the preset's -O2 -g1.
+target_compile_options(sphfsi_unit_tests_sanitized PRIVATE ${_sphfsi_sanitize} -O1 -g)
+target_link_options(sphfsi_unit_tests_sanitized PRIVATE ${_sphfsi_sanitize})
+target_compile_definitions(sphfsi_unit_tests_sanitized PRIVATE
+  SPHFSI_SHARED_DATA_DIR="${SPHFSI_SHARED_DATA_DIR}"
+  SPHFSI_TEST_OUTPUT_DIR="${CMAKE_CURRENT_BINARY_DIR}/output_sanitized")
+unset(_sphfsi_sanitize)
+
+add_test(NAME sanitizer.unit_tests COMMAND sphfsi_unit_tests_sanitized)
+set_tests_properties(sanitizer.unit_tests PROPERTIES
+  LABELS sanitizer
+  TIMEOUT 600
+  ENVIRONMENT "ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:halt_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1;UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1;OMP_WAIT_POLICY=passive")
