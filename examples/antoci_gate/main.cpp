@@ -63,12 +63,12 @@ int run(const Options& opt, const Coupling& coupling) {
   using Gate = CoupledBody<Coupling, Solid>;
   Simulation<System, SymplecticVerlet, Gate> sim(system, scene.fluid(), {}, Gate(coupling, std::move(solid)));
 
-  fmt::print("Antoci gate, {} coupling, {} solid: dp = {:.4g} m, {} fluid, {} wall, {} solid particles; c0 fluid {} m/s, "
-             "solid P-wave {:.3g} m/s\n",
-             Coupling::name, std::is_same_v<Solid, TotalLagrangian> ? "total-Lagrangian" : "updated-Lagrangian",
-             scene.dp(), system.particles().count(Kind::fluid), system.particles().count(Kind::wall),
-             system.particles().count(Kind::solid), scene.fluid_sound_speed,
-             scene.solid_material().p_wave_speed());
+  fmt::print(
+      "Antoci gate, {} coupling, {} solid: dp = {:.4g} m, {} fluid, {} wall, {} solid particles; c0 fluid {} m/s, "
+      "solid P-wave {:.3g} m/s\n",
+      Coupling::name, std::is_same_v<Solid, TotalLagrangian> ? "total-Lagrangian" : "updated-Lagrangian", scene.dp(),
+      system.particles().count(Kind::fluid), system.particles().count(Kind::wall),
+      system.particles().count(Kind::solid), scene.fluid_sound_speed, scene.solid_material().p_wave_speed());
 
   std::filesystem::create_directories(opt.output);
   io::CsvWriter tip_csv(opt.output / "gate_tip.csv", {"t", "dx", "dy", "max_stretch", "fluid_inside_gate"});
@@ -106,13 +106,14 @@ int run(const Options& opt, const Coupling& coupling) {
                                             opt.end_time);
   fmt::print("{} steps to t = {:.3f} s in {:.1f} s wall ({:.2f} million particle-steps/s)\n", sim.step_count(),
              sim.time(), wall, double(system.size()) * double(sim.step_count()) / wall * 1e-6);
-  fmt::print("RMS error vs experiment at t = 0.04 ... {:.2f} s ({} points): dx {:.2f} mm, dy {:.2f} mm "
-             "(Antoci 2007 SPH: 3.9 / 1.8 mm)\n",
-             std::min(0.36, opt.end_time), cmp.points, 1e3 * cmp.rms_dx, 1e3 * cmp.rms_dy);
-  fmt::print("failure flags: max stretch {:.3f}, fluid particles inside the gate (max) {}, blow-up: {}\n",
-             max_stretch, max_inside, failure.empty() ? "no" : failure);
-  io::CsvWriter summary(opt.output / "summary.csv", {"rms_dx", "rms_dy", "wall_s", "steps", "particles",
-                                                     "max_stretch", "fluid_inside_max", "blew_up", "end_time"});
+  fmt::print(
+      "RMS error vs experiment at t = 0.04 ... {:.2f} s ({} points): dx {:.2f} mm, dy {:.2f} mm "
+      "(Antoci 2007 SPH: 3.9 / 1.8 mm)\n",
+      std::min(0.36, opt.end_time), cmp.points, 1e3 * cmp.rms_dx, 1e3 * cmp.rms_dy);
+  fmt::print("failure flags: max stretch {:.3f}, fluid particles inside the gate (max) {}, blow-up: {}\n", max_stretch,
+             max_inside, failure.empty() ? "no" : failure);
+  io::CsvWriter summary(opt.output / "summary.csv", {"rms_dx", "rms_dy", "wall_s", "steps", "particles", "max_stretch",
+                                                     "fluid_inside_max", "blew_up", "end_time"});
   summary.write_row({cmp.rms_dx, cmp.rms_dy, wall, Scalar(sim.step_count()), Scalar(system.size()), max_stretch,
                      Scalar(max_inside), failure.empty() ? 0.0 : 1.0, sim.time()});
   const std::string plot = fmt::format("/usr/bin/python3 {}/examples/antoci_gate/plot.py {} {}", SPHFSI_SOURCE_DIR,
@@ -135,15 +136,18 @@ int main(int argc, char** argv) try {
   Options opt;
   const std::string coupling = cli.get("coupling", "repulsive", "FSI coupling: stress | interface | repulsive");
   const std::string solid = cli.get("solid", "tl", "solid model: tl (total Lagrangian) | ul (updated Lagrangian)");
-  opt.scene.particles_across = cli.get_number("resolution", 80, "particles across the water column A/dp (multiple of 20)");
+  opt.scene.particles_across =
+      cli.get_number("resolution", 80, "particles across the water column A/dp (multiple of 20)");
   opt.scene.fluid_sound_speed = cli.get_number("fluid-sound-speed", 20, "fluid reference sound speed c0, m/s");
   opt.scene.youngs_modulus = cli.get_number("youngs-modulus", 1.2e7, "gate Young's modulus E, Pa");
   opt.end_time = cli.get_number("end-time", 0.4, "simulated time, s");
   opt.snapshot_interval = cli.get_number("snapshot-interval", 0.02, "time between VTK snapshots, s");
   opt.output = cli.get("output", "out/antoci_gate", "output folder");
   opt.data_dir = cli.get("data", SPHFSI_SHARED_DATA_DIR, "folder with antoci2007_gate_tip_*.csv");
-  opt.max_rms_dx = 1e-3 * cli.get_number("max-rms-dx", 1000, "exit with status 2 if the RMS error in dx exceeds this, mm");
-  opt.max_rms_dy = 1e-3 * cli.get_number("max-rms-dy", 1000, "exit with status 2 if the RMS error in dy exceeds this, mm");
+  opt.max_rms_dx =
+      1e-3 * cli.get_number("max-rms-dx", 1000, "exit with status 2 if the RMS error in dx exceeds this, mm");
+  opt.max_rms_dy =
+      1e-3 * cli.get_number("max-rms-dy", 1000, "exit with status 2 if the RMS error in dy exceeds this, mm");
   if (!cli.finish()) return 0;
   require_positive("--end-time (s)", opt.end_time);
   if (solid != "tl" && solid != "ul")
@@ -154,11 +158,15 @@ int main(int argc, char** argv) try {
   repulsive.local_depth = opt.scene.column_height;
   const bool tl = solid == "tl";
   if (coupling == "stress")
-    return tl ? run<TotalLagrangian>(opt, StressContinuity<Scalar>{}) : run<UpdatedLagrangian>(opt, StressContinuity<Scalar>{});
+    return tl ? run<TotalLagrangian>(opt, StressContinuity<Scalar>{})
+              : run<UpdatedLagrangian>(opt, StressContinuity<Scalar>{});
   if (coupling == "interface")
-    return tl ? run<TotalLagrangian>(opt, InterfacePressure<Scalar>{}) : run<UpdatedLagrangian>(opt, InterfacePressure<Scalar>{});
-  if (coupling == "repulsive") return tl ? run<TotalLagrangian>(opt, repulsive) : run<UpdatedLagrangian>(opt, repulsive);
-  throw InputError(fmt::format("--coupling = '{}' is invalid: valid values are stress, interface, repulsive", coupling));
+    return tl ? run<TotalLagrangian>(opt, InterfacePressure<Scalar>{})
+              : run<UpdatedLagrangian>(opt, InterfacePressure<Scalar>{});
+  if (coupling == "repulsive")
+    return tl ? run<TotalLagrangian>(opt, repulsive) : run<UpdatedLagrangian>(opt, repulsive);
+  throw InputError(
+      fmt::format("--coupling = '{}' is invalid: valid values are stress, interface, repulsive", coupling));
 } catch (const std::exception& e) {
   fmt::print(stderr, "antoci_gate: error: {}\n", e.what());
   return 1;

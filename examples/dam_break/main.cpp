@@ -34,12 +34,12 @@ int main(int argc, char** argv) try {
   scene.particles_across = cli.get_number("resolution", 40, "particles across the column width a (a/dp)");
   scene.column_height_ratio = cli.get_number("height-ratio", 1, "column height over width, n^2 = H/a");
   scene.walls = cli.get("walls", "dynamic", "wall model: dynamic | repulsive") == "repulsive" ? WallModel::repulsive
-                                                                                               : WallModel::dynamic;
+                                                                                              : WallModel::dynamic;
   const Scalar end_T = cli.get_number("end-time", 2.0, "end time, in units of sqrt(a/g)");
   const Scalar snapshots = cli.get_number("snapshots", 12, "number of VTK snapshots (0: none)");
   const std::filesystem::path out = cli.get("output", "out/dam_break", "output folder");
-  const std::string data = cli.get("data", SPHFSI_SHARED_DATA_DIR "/martin_moyce1952_surge_front.csv",
-                                   "Martin & Moyce surge-front CSV");
+  const std::string data =
+      cli.get("data", SPHFSI_SHARED_DATA_DIR "/martin_moyce1952_surge_front.csv", "Martin & Moyce surge-front CSV");
   if (!cli.finish()) return 0;
 
   System system(scenes::dam_break_domain(scene), Tait<Scalar>(1000, scene.sound_speed()));

@@ -30,7 +30,8 @@ int main(int argc, char** argv) try {
   const double period = cli.get_number("period", 1.4286, "wave period T, s");
   const double gravity = cli.get_number("gravity", 9.81, "m/s^2");
   analysis::StemField stems;
-  stems.stem_height = cli.get_number("stem-height", 0.13, "stem height l_s (effective length l_e of flexible blades), m");
+  stems.stem_height =
+      cli.get_number("stem-height", 0.13, "stem height l_s (effective length l_e of flexible blades), m");
   stems.frontal_width = cli.get_number("frontal-width", 0.003, "stem frontal width b_v, m");
   stems.density = cli.get_number("stem-density", 7200, "stems per m^2, N");
   const double x_min = cli.get_number("x-min", -1e30, "use points with x >= x-min, m");
@@ -54,14 +55,13 @@ int main(int argc, char** argv) try {
              wave.kh(), wave.wavelength);
   fmt::print("stems: l_s = {} m, b_v = {} m, N = {} 1/m^2 (b_v N = {:.3g} 1/m)\n", stems.stem_height,
              stems.frontal_width, stems.density, stems.frontal_width * stems.density);
-  if (fit.incident_height_fixed)
-    fmt::print("H0    = {:.5f} m (fixed)\n", fit.incident_height);
-  else
-    fmt::print("H0    = {:.5f} +- {:.5f} m\n", fit.incident_height, fit.se_height());
+  if (fit.incident_height_fixed) fmt::print("H0    = {:.5f} m (fixed)\n", fit.incident_height);
+  else fmt::print("H0    = {:.5f} +- {:.5f} m\n", fit.incident_height, fit.se_height());
   fmt::print("alpha = {:.5f} +- {:.5f} 1/m   (RMS residual {:.2e} m)\n", fit.alpha, fit.se_alpha(), fit.rms_residual);
-  fmt::print("C_D   = {:.3f} +- {:.3f}   (standard error: fit covariance propagated to first order; scatter that is "
-             "correlated along x, e.g. partial standing waves, makes it an underestimate)\n",
-             cd.value, cd.standard_error);
+  fmt::print(
+      "C_D   = {:.3f} +- {:.3f}   (standard error: fit covariance propagated to first order; scatter that is "
+      "correlated along x, e.g. partial standing waves, makes it an underestimate)\n",
+      cd.value, cd.standard_error);
   return 0;
 } catch (const std::exception& e) {
   fmt::print(stderr, "fit_drag_coefficient: error: {}\n", e.what());

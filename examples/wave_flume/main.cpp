@@ -49,8 +49,8 @@ int run(const Options& o) {
   using Solver = Simulation<System, SymplecticVerlet, waves::DampingZone<T>>;
   scenes::WaveFlumeGeometry<T> g;
   const auto& s = o.scene;
-  g.wave = {s.wave.paddle, T(s.wave.wave_height), T(s.wave.period), T(s.wave.depth), T(s.wave.gravity),
-            T(s.wave.ramp_periods)};
+  g.wave = {s.wave.paddle,   T(s.wave.wave_height), T(s.wave.period),
+            T(s.wave.depth), T(s.wave.gravity),     T(s.wave.ramp_periods)};
   g.particles_per_depth = T(s.particles_per_depth);
   g.sound_speed_factor = T(s.sound_speed_factor);
   g.length_wavelengths = T(s.length_wavelengths);
@@ -72,8 +72,7 @@ int run(const Options& o) {
   const waves::Wavemaker<T> maker(g.wave);
   if (g.wave.paddle == waves::PaddleType::piston)
     sim.set_wall_motion(layout.paddle_body, maker.template piston_motion<2>());
-  else
-    sim.set_wall_kinematics(layout.paddle_body, maker.template flap_kinematics<2>(layout.paddle_x, T(0)));
+  else sim.set_wall_kinematics(layout.paddle_body, maker.template flap_kinematics<2>(layout.paddle_x, T(0)));
 
   const auto wave = maker.wave();
   const std::vector<T> gauge_x = scenes::wave_flume_gauges(g, o.gauges);
@@ -81,26 +80,28 @@ int run(const Options& o) {
   const double end_time = o.end_time > 0 ? o.end_time
                                          : double(maker.ramp_time()) + x_last / double(wave.group_velocity) +
                                                (o.waves_analysed + 1.5) * double(wave.period);
-  fmt::print("wave flume ({}): h = {:.4g} m, T = {:.5g} s, target H = {:.4g} m; kh = {:.3f}, L = {:.3f} m, c_g = {:.3f} m/s; {} "
-             "stroke S = {:.4f} m\n",
-             sizeof(T) == 4 ? "float" : "double", double(g.depth()), double(g.wave.period), double(g.wave.wave_height),
-             double(wave.kh()), double(wave.wavelength), double(wave.group_velocity),
-             g.wave.paddle == waves::PaddleType::piston ? "piston" : "flap", double(maker.stroke()));
-  fmt::print("resolution: dp = {:.5f} m, h/dp = {:.1f}, H/dp = {:.2f}, L/dp = {:.0f}; flume {:.2f} m; {} fluid + {} "
-             "wall particles; c0 = {:.2f} m/s; alpha = {:.4g}, delta = {:.4g}, nu = {:.3g} m^2/s; end time {:.2f} s\n",
-             double(g.dp()), double(g.particles_per_depth), double(g.wave.wave_height / g.dp()),
-             double(wave.wavelength / g.dp()), double(g.length()), layout.fluid_particles,
-             layout.wall_particles + layout.paddle_particles + layout.beach_particles, double(g.sound_speed()),
-             double(fluid.artificial_viscosity), double(fluid.density_diffusion), double(fluid.kinematic_viscosity),
-             end_time);
+  fmt::print(
+      "wave flume ({}): h = {:.4g} m, T = {:.5g} s, target H = {:.4g} m; kh = {:.3f}, L = {:.3f} m, c_g = {:.3f} m/s; "
+      "{} "
+      "stroke S = {:.4f} m\n",
+      sizeof(T) == 4 ? "float" : "double", double(g.depth()), double(g.wave.period), double(g.wave.wave_height),
+      double(wave.kh()), double(wave.wavelength), double(wave.group_velocity),
+      g.wave.paddle == waves::PaddleType::piston ? "piston" : "flap", double(maker.stroke()));
+  fmt::print(
+      "resolution: dp = {:.5f} m, h/dp = {:.1f}, H/dp = {:.2f}, L/dp = {:.0f}; flume {:.2f} m; {} fluid + {} "
+      "wall particles; c0 = {:.2f} m/s; alpha = {:.4g}, delta = {:.4g}, nu = {:.3g} m^2/s; end time {:.2f} s\n",
+      double(g.dp()), double(g.particles_per_depth), double(g.wave.wave_height / g.dp()),
+      double(wave.wavelength / g.dp()), double(g.length()), layout.fluid_particles,
+      layout.wall_particles + layout.paddle_particles + layout.beach_particles, double(g.sound_speed()),
+      double(fluid.artificial_viscosity), double(fluid.density_diffusion), double(fluid.kinematic_viscosity), end_time);
 
   std::filesystem::create_directories(o.out);
   waves::WaveGauges<T> gauges(gauge_x, layout.still_level, g.dp());
-  gauges.open(o.out / "gauges.csv",
-              fmt::format("wave_flume: free-surface elevation eta (m) at x (m) = column suffix; h = {:.4g} m, T = {:.5g} s, "
-                          "target H = {:.4g} m, h/dp = {:.4g}",
-                          double(g.depth()), double(g.wave.period), double(g.wave.wave_height),
-                          double(g.particles_per_depth)));
+  gauges.open(
+      o.out / "gauges.csv",
+      fmt::format("wave_flume: free-surface elevation eta (m) at x (m) = column suffix; h = {:.4g} m, T = {:.5g} s, "
+                  "target H = {:.4g} m, h/dp = {:.4g}",
+                  double(g.depth()), double(g.wave.period), double(g.wave.wave_height), double(g.particles_per_depth)));
   io::CsvWriter paddle_csv(o.out / "paddle.csv", {"t", "X", "dXdt"});
   io::VtkSeriesWriter vtk(o.out, "wave_flume");
   const double sample_every = double(g.wave.period) / 40;
@@ -112,8 +113,8 @@ int run(const Options& o) {
     progress(sm);
     if (double(sm.time()) >= next_sample) {
       gauges.sample(sm.system(), sm.time());
-      paddle_csv.write_row({double(sm.time()), double(maker.displacement(sm.time())),
-                            double(maker.velocity(sm.time()))});
+      paddle_csv.write_row(
+          {double(sm.time()), double(maker.displacement(sm.time())), double(maker.velocity(sm.time()))});
       next_sample += sample_every;
     }
     if (o.snapshots > 0 && double(sm.time()) >= next_snapshot) {
@@ -134,15 +135,15 @@ int run(const Options& o) {
   fmt::print("gauge   x (m)   x/L   waves   H (m)    H/H_target   T (s)\n");
   for (std::size_t i = 0; i < gauge_x.size(); ++i) {
     std::vector<double> eta(gauges.series(i).begin(), gauges.series(i).end());
-    const double from = double(maker.ramp_time()) + double(gauge_x[i]) / double(wave.group_velocity) +
-                        double(wave.period);
+    const double from =
+        double(maker.ramp_time()) + double(gauge_x[i]) / double(wave.group_velocity) + double(wave.period);
     try {
       const auto w = analysis::zero_crossing_analysis(t, eta, from, end_time);
       const double x = double(gauge_x[i]), ratio = w.mean_height / double(g.wave.wave_height);
       fmt::print("{:5d}  {:6.3f}  {:4.2f}  {:5d}  {:.5f}  {:10.4f}  {:6.4f}\n", i, x, x / double(wave.wavelength),
                  w.count(), w.mean_height, ratio, w.mean_period);
-      heights.write_row({x, x / double(wave.wavelength), w.mean_height, w.height_std, ratio, w.mean_period,
-                         double(w.count())});
+      heights.write_row(
+          {x, x / double(wave.wavelength), w.mean_height, w.height_std, ratio, w.mean_period, double(w.count())});
       if (i == 0) h_first = w.mean_height, t_first = w.mean_period;
       xs.push_back(x / double(wave.wavelength));
       log_h.push_back(std::log(w.mean_height));
@@ -157,15 +158,16 @@ int run(const Options& o) {
     for (std::size_t i = 0; i < xs.size(); ++i) mx += xs[i], my += log_h[i];
     mx /= double(xs.size()), my /= double(xs.size());
     double sxy = 0, sxx = 0;
-    for (std::size_t i = 0; i < xs.size(); ++i) sxy += (xs[i] - mx) * (log_h[i] - my), sxx += (xs[i] - mx) * (xs[i] - mx);
+    for (std::size_t i = 0; i < xs.size(); ++i)
+      sxy += (xs[i] - mx) * (log_h[i] - my), sxx += (xs[i] - mx) * (xs[i] - mx);
     decay = 1 - std::exp(sxy / sxx);
   }
   const double generated_error = h_first / double(g.wave.wave_height) - 1;
   fmt::print("generated height one wavelength from the paddle: {:+.1f} % of the target\n", 100 * generated_error);
   fmt::print("decay along the flume ({} gauges over {:.0f} wavelengths): {:.2f} % per wavelength\n", xs.size(),
              xs.empty() ? 0.0 : xs.back() - xs.front(), 100 * decay);
-  const std::string plot = fmt::format("/usr/bin/python3 {}/examples/wave_flume/plot.py {}", SPHFSI_SOURCE_DIR,
-                                       o.out.string());
+  const std::string plot =
+      fmt::format("/usr/bin/python3 {}/examples/wave_flume/plot.py {}", SPHFSI_SOURCE_DIR, o.out.string());
   std::fflush(stdout);
   if (std::system(plot.c_str()) != 0) fmt::print("(plot skipped: /usr/bin/python3 with matplotlib not available)\n");
   const double period_error = t_first / double(g.wave.period) - 1;
@@ -212,7 +214,8 @@ int main(int argc, char** argv) try {
   const std::string precision = cli.get("precision", "float", "scalar type: float | double");
   o.out = cli.get("output", "out/wave_flume", "output folder");
   if (!cli.finish()) return 0;
-  if (paddle != "piston" && paddle != "flap") throw InputError(fmt::format("--paddle '{}': valid are piston, flap", paddle));
+  if (paddle != "piston" && paddle != "flap")
+    throw InputError(fmt::format("--paddle '{}': valid are piston, flap", paddle));
   g.wave.paddle = paddle == "piston" ? waves::PaddleType::piston : waves::PaddleType::flap;
   if (absorber == "damping") g.absorber = scenes::FlumeAbsorber::damping_zone;
   else if (absorber == "beach") g.absorber = scenes::FlumeAbsorber::beach;

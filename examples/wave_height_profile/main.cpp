@@ -25,7 +25,8 @@ int main(int argc, char** argv) try {
   const double cg = cli.get_number("group-velocity", 0, "delay the window by x / c_g at each gauge, m/s (0: no delay)");
   const std::string crossing = cli.get("crossing", "up", "zero crossing: up | down");
   if (!cli.finish()) return 0;
-  if (crossing != "up" && crossing != "down") throw InputError(fmt::format("--crossing '{}': valid are up, down", crossing));
+  if (crossing != "up" && crossing != "down")
+    throw InputError(fmt::format("--crossing '{}': valid are up, down", crossing));
   if (cg < 0) throw InputError(fmt::format("--group-velocity = {} m/s: valid range is [0, inf)", cg));
 
   const auto table = io::read_csv(input);
@@ -44,8 +45,8 @@ int main(int argc, char** argv) try {
     ++gauges;
     const double start = from + (cg > 0 ? *x / cg : 0.0);
     try {
-      const auto w = analysis::zero_crossing_analysis(t, table.column(name), start, end,
-                                                      crossing == "up" ? analysis::Crossing::up : analysis::Crossing::down);
+      const auto w = analysis::zero_crossing_analysis(
+          t, table.column(name), start, end, crossing == "up" ? analysis::Crossing::up : analysis::Crossing::down);
       out.write_row({*x, w.mean_height, w.height_std, w.rms_height, w.mean_period, double(w.count())});
       fmt::print("{:9.4f}  {:.5f}  {:.5f}   {:.4f}  {}\n", *x, w.mean_height, w.height_std, w.mean_period, w.count());
     } catch (const InputError& e) {

@@ -14,9 +14,13 @@ struct WrappedWendland {
   virtual ~WrappedWendland() = default;
 #endif
   template <class T>
-  T value(T r, T h) const { return sphfsi::WendlandC2<3>{}.value(r, h); }
+  T value(T r, T h) const {
+    return sphfsi::WendlandC2<3>{}.value(r, h);
+  }
   template <class T>
-  T derivative(T r, T h) const { return sphfsi::WendlandC2<3>{}.derivative(r, h); }
+  T derivative(T r, T h) const {
+    return sphfsi::WendlandC2<3>{}.derivative(r, h);
+  }
 };
 
 std::size_t build_scene() {

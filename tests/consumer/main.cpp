@@ -55,9 +55,10 @@ int run() {
     max_speed = std::max(max_speed, p.velocity[i].norm());
   }
   const double mass = total_mass(system);
-  std::printf("sphfsi consumer: %zu particles (%zu fluid), %zu steps to t = %.3g s, %d thread(s), mass %.9g -> %.9g "
-              "kg/m, max speed %.3g m/s\n",
-              count, fluid, sim.step_count(), sim.time(), sphfsi::thread_count(), mass0, mass, max_speed);
+  std::printf(
+      "sphfsi consumer: %zu particles (%zu fluid), %zu steps to t = %.3g s, %d thread(s), mass %.9g -> %.9g "
+      "kg/m, max speed %.3g m/s\n",
+      count, fluid, sim.step_count(), sim.time(), sphfsi::thread_count(), mass0, mass, max_speed);
   if (system.size() != count || sim.step_count() != 20 || !(sim.time() > 0)) {
     std::fprintf(stderr, "particle count or step count changed\n");
     return 1;

@@ -43,7 +43,8 @@ double max_third_derivative(const E& eos, double lo, double hi) {
   for (int k = 0; k <= 200; ++k) {
     const double rho = lo + (hi - lo) * k / 200.0;
     const double d3 = (eos.pressure(rho + 2 * step) - 2 * eos.pressure(rho + step) + 2 * eos.pressure(rho - step) -
-                       eos.pressure(rho - 2 * step)) / (2 * step * step * step);
+                       eos.pressure(rho - 2 * step)) /
+                      (2 * step * step * step);
     m = std::max(m, std::abs(d3));
   }
   return m;

@@ -94,8 +94,8 @@ std::string attribute(const std::string& xml, std::size_t tag_pos, const std::st
 /// Decodes the named DataArray of a .vtu written by sphfsi (either encoding) into elements of type E.
 template <class E>
 std::vector<E> read_array(const std::string& vtu, const std::string& name, int* components = nullptr) {
-  const auto tag = vtu.find("<DataArray type=\"" + std::string(sphfsi::io::detail::vtk_type_name<E>()) +
-                            "\" Name=\"" + name + "\"");
+  const auto tag =
+      vtu.find("<DataArray type=\"" + std::string(sphfsi::io::detail::vtk_type_name<E>()) + "\" Name=\"" + name + "\"");
   REQUIRE(tag != std::string::npos);
   if (components) {
     const auto c = attribute(vtu, tag, "NumberOfComponents");
@@ -325,7 +325,8 @@ TEST_CASE("read_csv parses comments, blanks, empty fields and labels, with clear
   std::ofstream(dir / "only_comments.csv") << "# nothing\n\n";
   CHECK_THROWS_WITH(sphfsi::io::read_csv(dir / "only_comments.csv"), Catch::Contains("has no header line"));
   std::ofstream(dir / "trailing.csv") << "x\n1.5abc\n";
-  CHECK_THROWS_WITH(sphfsi::io::read_csv(dir / "trailing.csv").column("x"), Catch::Contains("'1.5abc' is not a number"));
+  CHECK_THROWS_WITH(sphfsi::io::read_csv(dir / "trailing.csv").column("x"),
+                    Catch::Contains("'1.5abc' is not a number"));
 }
 
 TEST_CASE("read_csv reads the shipped validation data", "[io][csv]") {

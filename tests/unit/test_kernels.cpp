@@ -46,8 +46,8 @@ double radial_measure(double r) {
 /// piecewise-polynomial kernels (degree <= 7 in r including the measure) each piece is integrated exactly.
 template <class K, class T>
 double integrate_kernel(T h, int pieces) {
-  static constexpr std::array<double, 5> node = {-0.9061798459386640, -0.5384693101056831, 0.0,
-                                                 0.5384693101056831, 0.9061798459386640};
+  static constexpr std::array<double, 5> node = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831,
+                                                 0.9061798459386640};
   static constexpr std::array<double, 5> weight = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889,
                                                    0.4786286704993665, 0.2369268850561891};
   const K kernel{};
@@ -78,8 +78,9 @@ double max_higher_derivative(int order, double h) {
     const double q = r / h;
     if (std::abs(q - std::round(q)) < 4.0 * step / h) continue;
     const double d2 = (kernel.derivative(r + step, h) - kernel.derivative(r - step, h)) / (2.0 * step);
-    const double d3 = (kernel.derivative(r + step, h) - 2.0 * kernel.derivative(r, h) +
-                       kernel.derivative(r - step, h)) / (step * step);
+    const double d3 =
+        (kernel.derivative(r + step, h) - 2.0 * kernel.derivative(r, h) + kernel.derivative(r - step, h)) /
+        (step * step);
     m = std::max(m, std::abs(order == 2 ? d2 : d3));
   }
   return m;
@@ -130,14 +131,20 @@ struct MissingDerivative {
   static constexpr int dimension = 2;
   static constexpr double support = 2.0;
   template <class T>
-  T value(T, T) const { return T(0); }
+  T value(T, T) const {
+    return T(0);
+  }
 };
 struct MissingSupport {
   static constexpr int dimension = 2;
   template <class T>
-  T value(T, T) const { return T(0); }
+  T value(T, T) const {
+    return T(0);
+  }
   template <class T>
-  T derivative(T, T) const { return T(0); }
+  T derivative(T, T) const {
+    return T(0);
+  }
 };
 struct WrongReturnType {  // always returns double, so it cannot serve a float system
   static constexpr int dimension = 2;
@@ -150,9 +157,13 @@ struct NotTriviallyCopyable {  // a virtual function: cannot be captured by valu
   static constexpr double support = 2.0;
   virtual ~NotTriviallyCopyable() = default;
   template <class T>
-  T value(T, T) const { return T(0); }
+  T value(T, T) const {
+    return T(0);
+  }
   template <class T>
-  T derivative(T, T) const { return T(0); }
+  T derivative(T, T) const {
+    return T(0);
+  }
 };
 }  // namespace broken
 static_assert(!SmoothingKernel<broken::MissingDerivative, double>);
@@ -160,15 +171,15 @@ static_assert(!SmoothingKernel<broken::MissingSupport, double>);
 static_assert(SmoothingKernel<broken::WrongReturnType, double> && !SmoothingKernel<broken::WrongReturnType, float>);
 static_assert(!SmoothingKernel<broken::NotTriviallyCopyable, double>);
 
-TEMPLATE_TEST_CASE("kernel properties", "[kernel]",
-                   (KernelCase<CubicSpline<2>, double>), (KernelCase<CubicSpline<3>, double>),
-                   (KernelCase<WendlandC2<2>, double>), (KernelCase<WendlandC2<3>, double>),
-                   (KernelCase<QuinticSpline<2>, double>), (KernelCase<QuinticSpline<3>, double>),
-                   (KernelCase<TruncatedGaussian<2>, double>), (KernelCase<TruncatedGaussian<3>, double>),
-                   (KernelCase<CubicSpline<2>, float>), (KernelCase<CubicSpline<3>, float>),
-                   (KernelCase<WendlandC2<2>, float>), (KernelCase<WendlandC2<3>, float>),
-                   (KernelCase<QuinticSpline<2>, float>), (KernelCase<QuinticSpline<3>, float>),
-                   (KernelCase<TruncatedGaussian<2>, float>), (KernelCase<TruncatedGaussian<3>, float>)) {
+TEMPLATE_TEST_CASE("kernel properties", "[kernel]", (KernelCase<CubicSpline<2>, double>),
+                   (KernelCase<CubicSpline<3>, double>), (KernelCase<WendlandC2<2>, double>),
+                   (KernelCase<WendlandC2<3>, double>), (KernelCase<QuinticSpline<2>, double>),
+                   (KernelCase<QuinticSpline<3>, double>), (KernelCase<TruncatedGaussian<2>, double>),
+                   (KernelCase<TruncatedGaussian<3>, double>), (KernelCase<CubicSpline<2>, float>),
+                   (KernelCase<CubicSpline<3>, float>), (KernelCase<WendlandC2<2>, float>),
+                   (KernelCase<WendlandC2<3>, float>), (KernelCase<QuinticSpline<2>, float>),
+                   (KernelCase<QuinticSpline<3>, float>), (KernelCase<TruncatedGaussian<2>, float>),
+                   (KernelCase<TruncatedGaussian<3>, float>)) {
   using K = typename TestType::kernel;
   using T = typename TestType::scalar;
   constexpr int Dim = K::dimension;

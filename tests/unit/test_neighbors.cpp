@@ -204,21 +204,22 @@ TEMPLATE_TEST_CASE("a particle outside the domain stops update_neighbors with a 
   using T = typename TestType::scalar;
   using Vector = Vec<Dim, T>;
   ParticleSystem<Dim, T, QuinticSpline<Dim>, LinearEos<T>> system(Domain<Dim, T>(Vector::Zero(), Vector::Ones()),
-                                                                   LinearEos<T>(T(1000), T(20)));
+                                                                  LinearEos<T>(T(1000), T(20)));
   auto& p = system.particles();
-  for (int i = 0; i < 20; ++i) p.add(Kind::fluid, Vector::Constant(T(0.04) * T(i + 1)), Vector::Zero(), T(1000), T(1), T(0.02));
+  for (int i = 0; i < 20; ++i)
+    p.add(Kind::fluid, Vector::Constant(T(0.04) * T(i + 1)), Vector::Zero(), T(1000), T(1), T(0.02));
   REQUIRE_NOTHROW(system.update_neighbors());
 
   // Particle id 13 drifts just past the upper face along the last axis.
   const std::size_t slot = p.slot_of_id(13);
   p.position[slot][Dim - 1] = std::nextafter(T(1), T(2));
   CHECK_THROWS_AS(system.update_neighbors(T(0.25)), BlowUpError);
-  CHECK_THROWS_WITH(system.update_neighbors(T(0.25)), Catch::Matchers::Contains("particle id 13") &&
-                                                          Catch::Matchers::Contains("left the domain"));
+  CHECK_THROWS_WITH(system.update_neighbors(T(0.25)),
+                    Catch::Matchers::Contains("particle id 13") && Catch::Matchers::Contains("left the domain"));
   // A NaN position is reported as such.
   p.position[slot][0] = std::numeric_limits<T>::quiet_NaN();
-  CHECK_THROWS_WITH(system.update_neighbors(), Catch::Matchers::Contains("particle id 13") &&
-                                                   Catch::Matchers::Contains("position"));
+  CHECK_THROWS_WITH(system.update_neighbors(),
+                    Catch::Matchers::Contains("particle id 13") && Catch::Matchers::Contains("position"));
 }
 
 TEST_CASE("a cell grid too large for the 32-bit cell index is rejected with an InputError", "[neighbors]") {

@@ -92,9 +92,9 @@ struct GatherRates {
           continue;
         }
         if (p.kind[b] == Kind::wall && f.walls == WallModel::repulsive) {
-          acc += repulsive_force<Dim, T>(dx, vab, p.normal[b], h, c0,
-                                         p.position[a][f.repulsive.vertical_axis] - f.repulsive.water_level,
-                                         f.repulsive);
+          acc +=
+              repulsive_force<Dim, T>(dx, vab, p.normal[b], h, c0,
+                                      p.position[a][f.repulsive.vertical_axis] - f.repulsive.water_level, f.repulsive);
           continue;
         }
         const T mb = p.mass[b], ra = p.density[a], rb = p.density[b];
@@ -102,15 +102,15 @@ struct GatherRates {
         const T mu = h * vab.dot(dx) / (r * r + eta2);
         signal_speed[a] = std::max(signal_speed[a], std::abs(mu));
         density_rate[a] += mb * vab.dot(grad);
-        const T pi = vab.dot(dx) < 0 ? -f.artificial_viscosity * (p.sound_speed[a] + p.sound_speed[b]) / 2 * mu /
-                                           ((ra + rb) / 2)
-                                     : T(0);
+        const T pi = vab.dot(dx) < 0
+                         ? -f.artificial_viscosity * (p.sound_speed[a] + p.sound_speed[b]) / 2 * mu / ((ra + rb) / 2)
+                         : T(0);
         acc -= mb * (p.pressure[a] / (ra * ra) + p.pressure[b] / (rb * rb) + pi) * grad;
         acc += mb * f.kinematic_viscosity * (ra + rb) / (ra * rb) * dx.dot(grad) / (r * r + eta2) * vab;
         if (p.kind[b] == Kind::fluid) {
           const T hydrostatic = rho0 * f.gravity.dot(dx) / (c0 * c0);
-          density_rate[a] += f.density_diffusion * h * c0 * (mb / rb) * 2 * ((ra - rb) - hydrostatic) *
-                             dx.dot(grad) / (r * r + eta2);
+          density_rate[a] +=
+              f.density_diffusion * h * c0 * (mb / rb) * 2 * ((ra - rb) - hydrostatic) * dx.dot(grad) / (r * r + eta2);
           xsph[a] -= f.xsph * mb / ((ra + rb) / 2) * kernel.value(r, h) * vab;
         }
       }
@@ -166,8 +166,7 @@ TEMPLATE_TEST_CASE("for_each_neighbor_once visits every neighbour pair exactly o
   CHECK(once == all);
 }
 
-TEST_CASE("compute_rates with pairs evaluated once equals the plain WCSPH gather, for any thread count",
-          "[fluid]") {
+TEST_CASE("compute_rates with pairs evaluated once equals the plain WCSPH gather, for any thread count", "[fluid]") {
   using T = double;
   using System = ParticleSystem<2, T, WendlandC2<2>, Tait<T>>;
   const bool repulsive = GENERATE(false, true);
@@ -182,8 +181,8 @@ TEST_CASE("compute_rates with pairs evaluated once equals the plain WCSPH gather
   // A few solid particles inside the column (left out of the fluid sums) and a disturbed state, so that every
   // term is non-zero: random velocities, densities within +-2 %.
   for (int k = 0; k < 5; ++k)
-    p.add(Kind::solid, Vec<2, T>(0.2 * scene.a(), (0.2 + 0.1 * k) * scene.height()), Vec<2, T>::Zero(), 1000,
-          p.mass[0], p.smoothing_length[0]);
+    p.add(Kind::solid, Vec<2, T>(0.2 * scene.a(), (0.2 + 0.1 * k) * scene.height()), Vec<2, T>::Zero(), 1000, p.mass[0],
+          p.smoothing_length[0]);
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   for (std::size_t i = 0; i < p.size(); ++i) {

@@ -120,8 +120,8 @@ void check_rigid_rotation_is_stress_free() {
   const double R = centre.norm(), centripetal = rubber.density * omega * omega * R * R;
   double sigma_max = 0;
   for (auto id : solid.particle_ids()) sigma_max = std::max(sigma_max, solid.cauchy_stress(id).norm());
-  INFO("largest |sigma| = " << sigma_max << " Pa, rho omega^2 R^2 = " << centripetal << " Pa, G = "
-                            << rubber.shear_modulus() << " Pa");
+  INFO("largest |sigma| = " << sigma_max << " Pa, rho omega^2 R^2 = " << centripetal
+                            << " Pa, G = " << rubber.shear_modulus() << " Pa");
   CHECK(sigma_max < 5 * centripetal);
   // the body really turned by 0.3 rad
   const auto first = p.slot_of_id(0);
@@ -238,8 +238,8 @@ TEST_CASE("Solid models: clamps hold, blow-ups and tearing stop the run with a c
   auto& q = system.particles();
   const auto before = q.position[q.slot_of_id(5)];
   q.velocity[q.slot_of_id(20)].x() = std::nan("");
-  CHECK_THROWS_WITH(solid.advance(system, 0.01, 1e-4), Catch::Contains("particle id 20") &&
-                                                           Catch::Contains("position") && Catch::Contains("t = 0.01"));
+  CHECK_THROWS_WITH(solid.advance(system, 0.01, 1e-4),
+                    Catch::Contains("particle id 20") && Catch::Contains("position") && Catch::Contains("t = 0.01"));
   CHECK(q.position[q.slot_of_id(5)] == before);
   // Tearing: a body pulled apart beyond the stretch limit.
   auto torn = make_system<2>();
@@ -252,8 +252,6 @@ TEST_CASE("Solid models: clamps hold, blow-ups and tearing stop the run with a c
     torn.particles().velocity[i] = V(torn.particles().position[i].x() > 0.02 ? 50.0 : -50.0, 0);
   CHECK_THROWS_WITH(ul.advance(torn, 0.0, 2e-4), Catch::Contains("stretch") && Catch::Contains("tore"));
 }
-
-
 
 TEST_CASE("ElasticMaterial: derived moduli and input validation", "[solid]") {
   const auto m = rubber;

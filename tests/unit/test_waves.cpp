@@ -74,10 +74,12 @@ TEST_CASE("dispersion relation: residual and limits at all depths", "[waves]") {
   CHECK_THROWS_AS(waves::wave_number(1.0, -1.0), InputError);
 }
 
-TEST_CASE("Biesel transfer functions: closed forms against the quadrature of Biesel's integral, and limits", "[waves]") {
+TEST_CASE("Biesel transfer functions: closed forms against the quadrature of Biesel's integral, and limits",
+          "[waves]") {
   for (double kh : {0.05, 0.3, 0.593, 1.0, 2.0, 4.0}) {
     // Simpson with 2000 intervals: relative error ~ (kh/2000)^4, far below 1e-9
-    CHECK_THAT(waves::piston_height_to_stroke(kh), WithinRel(biesel_by_quadrature(kh, [](double) { return 1.0; }), 1e-9));
+    CHECK_THAT(waves::piston_height_to_stroke(kh),
+               WithinRel(biesel_by_quadrature(kh, [](double) { return 1.0; }), 1e-9));
     CHECK_THAT(waves::flap_height_to_stroke(kh), WithinRel(biesel_by_quadrature(kh, [](double u) { return u; }), 1e-9));
   }
   // shallow water: piston H/S -> kh (the displaced volume S h fills a crest of the wave), flap -> kh / 2

@@ -30,9 +30,9 @@ namespace sphfsi::analysis {
 
 /// Stem field of a Dalrymple-type meadow.
 struct StemField {
-  double stem_height{0};   ///< l_s (or the effective length l_e of flexible blades), m
-  double frontal_width{0}; ///< b_v, m
-  double density{0};       ///< N, stems per m^2
+  double stem_height{0};    ///< l_s (or the effective length l_e of flexible blades), m
+  double frontal_width{0};  ///< b_v, m
+  double density{0};        ///< N, stems per m^2
   void validate() const {
     require_positive("StemField::stem_height (m)", stem_height);
     require_positive("StemField::frontal_width (m)", frontal_width);
@@ -66,7 +66,7 @@ struct DecayFit {
   double incident_height{0};  ///< H0, m
   double alpha{0};            ///< 1/m
   double var_height{0}, var_alpha{0}, cov_height_alpha{0};
-  double rms_residual{0};     ///< sqrt(RSS / n), m
+  double rms_residual{0};  ///< sqrt(RSS / n), m
   std::size_t points{0};
   bool incident_height_fixed{false};
   double se_alpha() const { return std::sqrt(var_alpha); }
@@ -79,13 +79,13 @@ struct DecayFit {
 inline DecayFit fit_decay(std::span<const double> x, std::span<const double> height,
                           std::optional<double> fixed_incident_height = std::nullopt) {
   const std::size_t n = x.size();
-  if (height.size() != n)
-    throw InputError(fmt::format("fit_decay: {} positions but {} heights", n, height.size()));
+  if (height.size() != n) throw InputError(fmt::format("fit_decay: {} positions but {} heights", n, height.size()));
   const std::size_t parameters = fixed_incident_height ? 1 : 2;
   if (n < parameters + 1)
-    throw InputError(fmt::format("fit_decay: {} points given: valid range is >= {} (one more than the {} fitted "
-                                 "parameters, for an uncertainty)",
-                                 n, parameters + 1, parameters));
+    throw InputError(
+        fmt::format("fit_decay: {} points given: valid range is >= {} (one more than the {} fitted "
+                    "parameters, for an uncertainty)",
+                    n, parameters + 1, parameters));
   for (std::size_t i = 0; i < n; ++i) {
     require_finite("fit_decay x (m)", x[i]);
     require_positive("fit_decay H (m)", height[i]);
@@ -121,9 +121,10 @@ inline DecayFit fit_decay(std::span<const double> x, std::span<const double> hei
     for (std::size_t i = 0; i < n; ++i) {
       const double d = 1.0 + alpha * x[i];
       if (!(d > 0))
-        throw InputError(fmt::format("fit_decay: the fit reached 1 + alpha x <= 0 at x = {} m (alpha = {} 1/m): "
-                                     "the data do not follow H0 / (1 + alpha x)",
-                                     x[i], alpha));
+        throw InputError(
+            fmt::format("fit_decay: the fit reached 1 + alpha x <= 0 at x = {} m (alpha = {} 1/m): "
+                        "the data do not follow H0 / (1 + alpha x)",
+                        x[i], alpha));
       const double r = height[i] - H0 / d;
       const double j0 = 1.0 / d, j1 = -H0 * x[i] / (d * d);
       a00 += j0 * j0, a01 += j0 * j1, a11 += j1 * j1, g0 += j0 * r, g1 += j1 * r;
@@ -182,8 +183,8 @@ inline DragCoefficient drag_coefficient(const DecayFit& fit, const StemField& st
   c.value = fit.alpha / (scale * fit.incident_height);
   const double d_alpha = 1.0 / (scale * fit.incident_height);
   const double d_H0 = -fit.alpha / (scale * fit.incident_height * fit.incident_height);
-  const double var = d_alpha * d_alpha * fit.var_alpha + d_H0 * d_H0 * fit.var_height +
-                     2.0 * d_alpha * d_H0 * fit.cov_height_alpha;
+  const double var =
+      d_alpha * d_alpha * fit.var_alpha + d_H0 * d_H0 * fit.var_height + 2.0 * d_alpha * d_H0 * fit.cov_height_alpha;
   c.standard_error = std::sqrt(std::max(var, 0.0));
   return c;
 }

@@ -38,8 +38,8 @@ inline ZeroCrossingWaves zero_crossing_analysis(std::span<const double> time, st
   if (time.size() != eta.size())
     throw InputError(fmt::format("zero_crossing_analysis: {} times but {} elevations", time.size(), eta.size()));
   if (!(t_end > t_start))
-    throw InputError(fmt::format("zero_crossing_analysis: t_end = {} s must be greater than t_start = {} s", t_end,
-                                 t_start));
+    throw InputError(
+        fmt::format("zero_crossing_analysis: t_end = {} s must be greater than t_start = {} s", t_end, t_start));
   std::vector<double> t, e;
   for (std::size_t i = 0; i < time.size(); ++i) {
     if (i > 0 && !(time[i] > time[i - 1]))

@@ -39,8 +39,8 @@ void parallel_for(std::size_t n, Body&& body) {
 
 /// Splits [0, n) into `chunks` contiguous ranges, in index order, and calls body(begin, end, chunk) once per range,
 /// the ranges shared out to the threads dynamically (whichever thread is free takes the next range, so cheap ranges
-/// or a thread descheduled by other work on the machine do not leave the others waiting). For loops whose iterations also write to a few later indices: each
-/// range knows its bounds and can set aside what it would write beyond `end`.
+/// or a thread descheduled by other work on the machine do not leave the others waiting). For loops whose iterations
+/// also write to a few later indices: each range knows its bounds and can set aside what it would write beyond `end`.
 template <class Body>
 void parallel_chunks(std::size_t n, std::size_t chunks, Body&& body) {
   if (chunks == 0) chunks = 1;

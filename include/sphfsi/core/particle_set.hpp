@@ -11,7 +11,6 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <cstddef>
 #include <limits>
 #include <new>
 #include <vector>
@@ -26,19 +25,19 @@ struct ParticleSet {
   using scalar_type = T;
 
   // State.
-  std::vector<Vector> position;       ///< m
-  std::vector<Vector> velocity;       ///< m/s
-  std::vector<T> density;             ///< kg/m^3
-  std::vector<T> mass;                ///< kg (per unit depth in 2D: kg/m)
-  std::vector<T> smoothing_length;    ///< h, m
-  std::vector<Kind> kind;             ///< fluid, wall or solid
-  std::vector<std::int32_t> body;     ///< body or wall group index (-1: none); solids use it for the body id
-  std::vector<std::uint32_t> id;      ///< stable identity, index at creation
-  std::vector<Vector> normal;         ///< outward unit normal of wall/solid surface particles (zero elsewhere)
+  std::vector<Vector> position;     ///< m
+  std::vector<Vector> velocity;     ///< m/s
+  std::vector<T> density;           ///< kg/m^3
+  std::vector<T> mass;              ///< kg (per unit depth in 2D: kg/m)
+  std::vector<T> smoothing_length;  ///< h, m
+  std::vector<Kind> kind;           ///< fluid, wall or solid
+  std::vector<std::int32_t> body;   ///< body or wall group index (-1: none); solids use it for the body id
+  std::vector<std::uint32_t> id;    ///< stable identity, index at creation
+  std::vector<Vector> normal;       ///< outward unit normal of wall/solid surface particles (zero elsewhere)
 
   // Derived per-particle quantities (recomputed each evaluation).
-  std::vector<T> pressure;            ///< Pa
-  std::vector<T> sound_speed;         ///< m/s
+  std::vector<T> pressure;     ///< Pa
+  std::vector<T> sound_speed;  ///< m/s
 
   // Rates (recomputed each evaluation).
   std::vector<Vector> acceleration;   ///< dv/dt, m/s^2
@@ -115,8 +114,10 @@ struct ParticleSet {
     slot_of_id_.assign(n, std::numeric_limits<std::uint32_t>::max());
     for (std::size_t i = 0; i < n; ++i) {
       if (id[i] >= n || slot_of_id_[id[i]] != std::numeric_limits<std::uint32_t>::max())
-        throw InputError(fmt::format("ParticleSet: particle id {} in slot {} is out of range or repeated: ids must "
-                                     "be a permutation of 0 .. {}", id[i], i, n - 1));
+        throw InputError(
+            fmt::format("ParticleSet: particle id {} in slot {} is out of range or repeated: ids must "
+                        "be a permutation of 0 .. {}",
+                        id[i], i, n - 1));
       slot_of_id_[id[i]] = static_cast<std::uint32_t>(i);
     }
   }

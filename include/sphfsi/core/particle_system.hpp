@@ -28,7 +28,7 @@ namespace sphfsi {
 
 template <int Dim, Real T, class Kernel, class Eos>
   requires SpatialDimension<Dim> && SmoothingKernel<Kernel, T> && EquationOfState<Eos, T> &&
-           KernelOfDimension<Kernel, Dim>
+      KernelOfDimension<Kernel, Dim>
 class ParticleSystem {
  public:
   static constexpr int dimension = Dim;
@@ -57,14 +57,14 @@ class ParticleSystem {
       else if (!p.velocity[i].allFinite()) bad = "velocity";
       else if (!std::isfinite(p.density[i]) || !(p.density[i] > T(0))) bad = "density";
       if (bad)
-        throw BlowUpError(fmt::format("blow-up at t = {:.6g} s: {} particle id {} has a non-finite or non-physical "
-                                      "{} (x = [{}], v = [{}], rho = {})",
-                                      time, kind_name(p.kind[i]), p.id[i], bad, fmt_vec(p.position[i]),
-                                      fmt_vec(p.velocity[i]), p.density[i]));
+        throw BlowUpError(fmt::format(
+            "blow-up at t = {:.6g} s: {} particle id {} has a non-finite or non-physical "
+            "{} (x = [{}], v = [{}], rho = {})",
+            time, kind_name(p.kind[i]), p.id[i], bad, fmt_vec(p.position[i]), fmt_vec(p.velocity[i]), p.density[i]));
       if (!domain_.contains(p.position[i]))
-        throw BlowUpError(fmt::format("at t = {:.6g} s: {} particle id {} left the domain: x = [{}], domain [{}] to [{}]",
-                                      time, kind_name(p.kind[i]), p.id[i], fmt_vec(p.position[i]),
-                                      fmt_vec(domain_.lower), fmt_vec(domain_.upper)));
+        throw BlowUpError(fmt::format(
+            "at t = {:.6g} s: {} particle id {} left the domain: x = [{}], domain [{}] to [{}]", time,
+            kind_name(p.kind[i]), p.id[i], fmt_vec(p.position[i]), fmt_vec(domain_.lower), fmt_vec(domain_.upper)));
     }
   }
 
@@ -156,8 +156,8 @@ class ParticleSystem {
   Kernel kernel_;
   Particles particles_;
   CellList<Dim, T> cells_;
-  T h_uniform_{1};          // the smoothing length when uniform_h_, m
-  bool uniform_h_{false};   // all smoothing lengths equal at the last update_neighbors()
+  T h_uniform_{1};         // the smoothing length when uniform_h_, m
+  bool uniform_h_{false};  // all smoothing lengths equal at the last update_neighbors()
 };
 
 }  // namespace sphfsi

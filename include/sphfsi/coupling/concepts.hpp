@@ -20,9 +20,9 @@ namespace sphfsi {
 
 template <class C, class System, class Solid>
 concept FsiCoupling = std::is_trivially_copyable_v<C> &&
-                      requires(const C& c, System& s, const Solid& solid, typename System::scalar_type t) {
-                        { C::name } -> std::convertible_to<const char*>;
-                        c.apply(s, solid, t);
-                      };
+    requires(const C& c, System& s, const Solid& solid, typename System::scalar_type t) {
+  { C::name } -> std::convertible_to<const char*>;
+  c.apply(s, solid, t);
+};
 
 }  // namespace sphfsi

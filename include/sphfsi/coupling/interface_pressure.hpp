@@ -47,8 +47,8 @@ struct InterfacePressure {
       if (!surface[k]) continue;
       const std::size_t a = p.slot_of_id(ids[k]);
       const Vector n = p.normal[a];
-      const Vector x_int = p.position[a] + T(0.5) * d * n;   // (7), rl = 0
-      const Vector x_mirror = p.position[a] + d * n;         // mirror of a about the interface
+      const Vector x_int = p.position[a] + T(0.5) * d * n;  // (7), rl = 0
+      const Vector x_mirror = p.position[a] + d * n;        // mirror of a about the interface
       // Fluid particles near the interface and mirror points: the neighbours of a within one extra support.
       T shepard = 0, pressure_sum = 0, reaction_norm = 0;
       Vector grad_sum = Vector::Zero();
@@ -76,11 +76,11 @@ struct InterfacePressure {
         }
       });
       if (shepard < min_shepard || reaction_norm <= T(0)) continue;
-      const T p_int = pressure_sum / shepard;                        // (12)
-      const Vector force_density = -p_int * grad_sum;                // (11), N/m^3
+      const T p_int = pressure_sum / shepard;                           // (12)
+      const Vector force_density = -p_int * grad_sum;                   // (11), N/m^3
       const Vector force = (p.mass[a] / p.density[a]) * force_density;  // V_a F_a, N (N/m in 2D)
-      p.acceleration[a] += force / p.mass[a];                        // (13)
-      for (std::size_t j = 0; j < fluid.size(); ++j)                 // (14-16), normalised
+      p.acceleration[a] += force / p.mass[a];                           // (13)
+      for (std::size_t j = 0; j < fluid.size(); ++j)                    // (14-16), normalised
         p.acceleration[fluid[j]] -= (weight[j] / reaction_norm) * force / p.mass[fluid[j]];
     }
   }

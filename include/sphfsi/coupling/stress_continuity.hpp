@@ -56,7 +56,7 @@ struct StressContinuity {
       const T ms = p.mass[s];
       system.for_each_neighbor(s, [&](std::size_t f, const Vector& dx_sf, T r, T h) {
         if (p.kind[f] != Kind::fluid) return;
-        const Vector dx = -dx_sf;  // x_f - x_s
+        const Vector dx = -dx_sf;                               // x_f - x_s
         const Vector grad = kernel_gradient(kernel, dx, r, h);  // grad_f W_fs
         const Vector vfs = p.velocity[f] - p.velocity[s];
         const T rho_f = p.density[f];

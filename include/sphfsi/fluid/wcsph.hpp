@@ -112,7 +112,7 @@ class WcsphFluid {
       p.density_rate[a] = T(0);
       p.xsph_velocity[a] = Vector::Zero();
       pressure_term_[a] = p.pressure[a] / (p.density[a] * p.density[a]);  // p / rho^2, Pa m^6/kg^2
-      volume_[a] = p.mass[a] / p.density[a];                               // m^3 (m^2 in 2D)
+      volume_[a] = p.mass[a] / p.density[a];                              // m^3 (m^2 in 2D)
     });
     // A few slot ranges per thread, handed out dynamically: wall particles cost less than fluid ones, and on a
     // shared machine a thread may be descheduled for a while.
@@ -206,10 +206,10 @@ class WcsphFluid {
     for (std::size_t a = begin; a < end; ++a) reach = std::max(reach, system.neighbor_once_end(a));
     spill.begin = end;
     spill.resize(reach - end);
-    const PartnerSink<false> direct{p.acceleration.data(), p.density_rate.data(), p.xsph_velocity.data(),
-                                    signal_speed_.data(), &spill, end};
-    const PartnerSink<true> spilling{p.acceleration.data(), p.density_rate.data(), p.xsph_velocity.data(),
-                                     signal_speed_.data(), &spill, end};
+    const PartnerSink<false> direct{
+        p.acceleration.data(), p.density_rate.data(), p.xsph_velocity.data(), signal_speed_.data(), &spill, end};
+    const PartnerSink<true> spilling{
+        p.acceleration.data(), p.density_rate.data(), p.xsph_velocity.data(), signal_speed_.data(), &spill, end};
     for (std::size_t a = begin; a < end; ++a) {
       if (system.neighbor_once_end(a) <= end) accumulate_particle(system, a, direct);
       else accumulate_particle(system, a, spilling);
@@ -274,8 +274,8 @@ class WcsphFluid {
       const T rho_b = rho[b];
       const T pi_ab = vr < T(0) ? -alpha * (ca + c[b]) * mu / (rho_a + rho_b) : T(0);
       const T force = pa + pressure_term[b] + pi_ab;
-      const T laminar = nu > T(0) ? nu * (rho_a + rho_b) / (rho_a * rho_b) * grad_factor * r2 * inverse_distance2
-                                  : T(0);
+      const T laminar =
+          nu > T(0) ? nu * (rho_a + rho_b) / (rho_a * rho_b) * grad_factor * r2 * inverse_distance2 : T(0);
       if (fluid_a) {
         acc -= (mass[b] * force) * grad;
         if (nu > T(0)) acc += (mass[b] * laminar) * vab;

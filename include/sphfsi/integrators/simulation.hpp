@@ -21,10 +21,10 @@ namespace sphfsi {
 
 template <Real T>
 struct TimeStepParameters {
-  T cfl{T(0.2)};          ///< CFL number applied to the stable step, (0, 1]
-  T fixed_dt{T(0)};       ///< fixed step, s (0: variable step)
-  T max_dt{T(1e-2)};      ///< upper bound of the variable step, s
-  T min_dt{T(1e-10)};     ///< a step below this is a blow-up ("collapsing time step"), s
+  T cfl{T(0.2)};       ///< CFL number applied to the stable step, (0, 1]
+  T fixed_dt{T(0)};    ///< fixed step, s (0: variable step)
+  T max_dt{T(1e-2)};   ///< upper bound of the variable step, s
+  T min_dt{T(1e-10)};  ///< a step below this is a blow-up ("collapsing time step"), s
 
   void validate() const {
     require_in_range("TimeStepParameters::cfl", cfl, T(1e-6), T(1));
@@ -74,9 +74,13 @@ class Simulation {
   WcsphFluid<System>& fluid() noexcept { return fluid_; }
   const WcsphFluid<System>& fluid() const noexcept { return fluid_; }
   template <std::size_t I>
-  auto& model() noexcept { return std::get<I>(models_); }
+  auto& model() noexcept {
+    return std::get<I>(models_);
+  }
   template <std::size_t I>
-  const auto& model() const noexcept { return std::get<I>(models_); }
+  const auto& model() const noexcept {
+    return std::get<I>(models_);
+  }
   static constexpr std::size_t model_count = sizeof...(Models);
   T time() const noexcept { return time_; }
   std::size_t step_count() const noexcept { return steps_; }
@@ -139,9 +143,10 @@ class Simulation {
     require_finite("Simulation::restore_state time (s)", time);
     require_non_negative("Simulation::restore_state last_dt (s)", last_dt);
     if ((!motions_.empty() || !kinematics_.empty()) && wall_reference_positions.size() != system_.particles().size())
-      throw InputError(fmt::format("Simulation::restore_state wall_reference_positions has {} entries: with moving "
-                                   "walls it needs one per particle ({})",
-                                   wall_reference_positions.size(), system_.particles().size()));
+      throw InputError(
+          fmt::format("Simulation::restore_state wall_reference_positions has {} entries: with moving "
+                      "walls it needs one per particle ({})",
+                      wall_reference_positions.size(), system_.particles().size()));
     time_ = time;
     steps_ = steps;
     dt_ = last_dt;
@@ -207,16 +212,18 @@ class Simulation {
     if (time_step_.fixed_dt > T(0)) {
       dt = time_step_.fixed_dt;
       if (dt > stable && steps_ == 0)
-        throw InputError(fmt::format("TimeStepParameters::fixed_dt = {} s is above the stability limit of this "
-                                     "scene (acoustic, force and viscous conditions): valid range is (0, {}] s",
-                                     dt, stable));
+        throw InputError(
+            fmt::format("TimeStepParameters::fixed_dt = {} s is above the stability limit of this "
+                        "scene (acoustic, force and viscous conditions): valid range is (0, {}] s",
+                        dt, stable));
     } else {
       dt = std::min(time_step_.cfl * stable, time_step_.max_dt);
     }
     if (!(dt >= time_step_.min_dt))
-      throw BlowUpError(fmt::format("time step collapsed at t = {:.6g} s, step {}: dt = {:.3g} s is below "
-                                    "min_dt = {:.3g} s (largest acceleration or sound speed exploded)",
-                                    time_, steps_, dt, time_step_.min_dt));
+      throw BlowUpError(
+          fmt::format("time step collapsed at t = {:.6g} s, step {}: dt = {:.3g} s is below "
+                      "min_dt = {:.3g} s (largest acceleration or sound speed exploded)",
+                      time_, steps_, dt, time_step_.min_dt));
     if (time_ + dt > end_limit_) dt = std::max(end_limit_ - time_, time_step_.min_dt);
     return dt;
   }

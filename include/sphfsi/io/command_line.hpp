@@ -38,8 +38,7 @@ class CommandLine {
     const std::string s = get(name, fmt::format("{}", default_value), help);
     char* end = nullptr;
     const double v = std::strtod(s.c_str(), &end);
-    if (end == s.c_str() || *end != '\0')
-      throw InputError(fmt::format("--{} = '{}' is not a number", name, s));
+    if (end == s.c_str() || *end != '\0') throw InputError(fmt::format("--{} = '{}' is not a number", name, s));
     return v;
   }
 

@@ -62,7 +62,8 @@ class CsvWriter {
     }
     out_.open(path_, std::ios::binary | std::ios::trunc);
     if (!out_)
-      throw InputError(fmt::format("CsvWriter: cannot open '{}' for writing: {}", path_.string(), std::strerror(errno)));
+      throw InputError(
+          fmt::format("CsvWriter: cannot open '{}' for writing: {}", path_.string(), std::strerror(errno)));
 
     std::string text;
     std::string_view rest = comment;
@@ -87,8 +88,8 @@ class CsvWriter {
   /// Appends one row; `values.size()` must equal the number of columns.
   void write_row(std::span<const double> values) {
     if (values.size() != columns_.size())
-      throw InputError(fmt::format("CsvWriter '{}': row has {} values but the header has {} columns",
-                                   path_.string(), values.size(), columns_.size()));
+      throw InputError(fmt::format("CsvWriter '{}': row has {} values but the header has {} columns", path_.string(),
+                                   values.size(), columns_.size()));
     line_.clear();
     for (std::size_t c = 0; c < values.size(); ++c) {
       if (c) line_ += ',';
@@ -112,8 +113,8 @@ class CsvWriter {
     out_.write(text.data(), static_cast<std::streamsize>(text.size()));
     out_.flush();
     if (!out_)
-      throw std::runtime_error(fmt::format("CsvWriter: error while writing '{}': {}", path_.string(),
-                                           std::strerror(errno)));
+      throw std::runtime_error(
+          fmt::format("CsvWriter: error while writing '{}': {}", path_.string(), std::strerror(errno)));
   }
 
   std::filesystem::path path_;
@@ -128,7 +129,9 @@ class CsvTable {
  public:
   CsvTable(std::filesystem::path source, std::vector<std::string> names, std::vector<std::vector<std::string>> cells,
            std::vector<std::size_t> line_numbers)
-      : source_(std::move(source)), names_(std::move(names)), cells_(std::move(cells)),
+      : source_(std::move(source)),
+        names_(std::move(names)),
+        cells_(std::move(cells)),
         lines_(std::move(line_numbers)) {}
 
   const std::filesystem::path& source() const noexcept { return source_; }
@@ -156,8 +159,8 @@ class CsvTable {
       if (ec == std::errc::result_out_of_range) {
         x = std::strtod(s.c_str(), nullptr);  // overflow or underflow: keep the +-inf or denormal strtod gives
       } else if (ec != std::errc{} || end != last) {
-        throw InputError(fmt::format("{}:{}: column '{}': field '{}' is not a number", source_.string(), lines_[r],
-                                     name, s));
+        throw InputError(
+            fmt::format("{}:{}: column '{}': field '{}' is not a number", source_.string(), lines_[r], name, s));
       }
       v.push_back(x);
     }

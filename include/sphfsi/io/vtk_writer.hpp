@@ -158,15 +158,13 @@ DataArraySpec make_array(std::string name, int components, std::size_t count, F 
 /// Array of 3-component vectors from Dim-vectors (z = 0 in 2D).
 template <int Dim, Real T>
 DataArraySpec vector_array(std::string name, std::span<const Vec<Dim, T>> v) {
-  return make_array<T>(std::move(name), 3, v.size(),
-                       [v](std::size_t i, int c) { return c < Dim ? v[i][c] : T(0); });
+  return make_array<T>(std::move(name), 3, v.size(), [v](std::size_t i, int c) { return c < Dim ? v[i][c] : T(0); });
 }
 
 template <class E>
 DataArraySpec scalar_array(std::string name, std::span<const E> v) {
   const std::size_t bytes = v.size() * sizeof(E);
-  return DataArraySpec{std::move(name), vtk_type_name<E>(), 1, bytes,
-                       [v, bytes](unsigned char* dst) {
+  return DataArraySpec{std::move(name), vtk_type_name<E>(), 1, bytes, [v, bytes](unsigned char* dst) {
                          if (bytes) std::memcpy(dst, v.data(), bytes);
                        }};
 }
@@ -266,12 +264,11 @@ inline void write_vtu_file(const std::filesystem::path& path, std::size_t n, dou
 
 /// Built-in field names: extra fields may not reuse them.
 inline constexpr std::string_view builtin_fields[] = {
-    "velocity", "acceleration", "normal",        "density", "pressure", "mass",        "smoothing_length",
-    "sound_speed", "density_rate", "xsph_velocity", "kind",  "body",     "id",          "position"};
+    "velocity",    "acceleration", "normal",        "density", "pressure", "mass", "smoothing_length",
+    "sound_speed", "density_rate", "xsph_velocity", "kind",    "body",     "id",   "position"};
 
 template <int Dim, Real T>
-std::vector<DataArraySpec> point_data_arrays(const ParticleSet<Dim, T>& p,
-                                             std::span<const PointField<Dim, T>> extra) {
+std::vector<DataArraySpec> point_data_arrays(const ParticleSet<Dim, T>& p, std::span<const PointField<Dim, T>> extra) {
   const std::size_t n = p.size();
   using V = Vec<Dim, T>;
   std::vector<DataArraySpec> a;
@@ -286,9 +283,8 @@ std::vector<DataArraySpec> point_data_arrays(const ParticleSet<Dim, T>& p,
   a.push_back(scalar_array<T>("smoothing_length", p.smoothing_length));
   a.push_back(scalar_array<T>("sound_speed", p.sound_speed));
   a.push_back(scalar_array<T>("density_rate", p.density_rate));
-  a.push_back(make_array<std::uint8_t>("kind", 1, n, [k = p.kind.data()](std::size_t i, int) {
-    return static_cast<std::uint8_t>(k[i]);
-  }));
+  a.push_back(make_array<std::uint8_t>(
+      "kind", 1, n, [k = p.kind.data()](std::size_t i, int) { return static_cast<std::uint8_t>(k[i]); }));
   a.push_back(scalar_array<std::int32_t>("body", p.body));
   a.push_back(scalar_array<std::uint32_t>("id", p.id));
 
@@ -302,8 +298,8 @@ std::vector<DataArraySpec> point_data_arrays(const ParticleSet<Dim, T>& p,
       if (extra[g].name() == e.name())
         throw InputError(fmt::format("VTK extra field name '{}' is given twice", e.name()));
     if (e.size() != n)
-      throw InputError(fmt::format("VTK extra field '{}' has {} values but the particle set has {} particles",
-                                   e.name(), e.size(), n));
+      throw InputError(fmt::format("VTK extra field '{}' has {} values but the particle set has {} particles", e.name(),
+                                   e.size(), n));
     if (e.is_vector()) a.push_back(vector_array<Dim, T>(e.name(), e.vectors()));
     else a.push_back(scalar_array<T>(e.name(), e.scalars()));
   }
@@ -336,13 +332,14 @@ class VtkSeriesWriter {
  public:
   /// Creates `directory` if needed. Throws InputError if the name is empty or contains a path separator, or if the
   /// directory cannot be created or is not a directory.
-  VtkSeriesWriter(std::filesystem::path directory, std::string name,
-                  VtkEncoding encoding = VtkEncoding::appended_raw)
+  VtkSeriesWriter(std::filesystem::path directory, std::string name, VtkEncoding encoding = VtkEncoding::appended_raw)
       : directory_(std::move(directory)), name_(std::move(name)), encoding_(encoding) {
     if (name_.empty()) throw InputError("VtkSeriesWriter: the series name is empty");
     if (name_.find_first_of("/\\") != std::string::npos || name_ == "." || name_ == "..")
-      throw InputError(fmt::format("VtkSeriesWriter: the series name '{}' must be a plain file name "
-                                   "(no '/' or '\\'); put folders in the directory argument", name_));
+      throw InputError(
+          fmt::format("VtkSeriesWriter: the series name '{}' must be a plain file name "
+                      "(no '/' or '\\'); put folders in the directory argument",
+                      name_));
     if (directory_.empty()) directory_ = ".";
     std::error_code ec;
     std::filesystem::create_directories(directory_, ec);

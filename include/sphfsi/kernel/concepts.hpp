@@ -18,12 +18,12 @@ namespace sphfsi {
 /// A smoothing kernel usable with scalar T (see the header comment for the full list of requirements).
 template <class K, class T>
 concept SmoothingKernel = std::is_trivially_copyable_v<K> && std::is_default_constructible_v<K> &&
-                          requires(const K& k, T r, T h) {
-                            { K::dimension } -> std::convertible_to<int>;
-                            { K::support } -> std::convertible_to<double>;
-                            { k.value(r, h) } -> std::same_as<T>;
-                            { k.derivative(r, h) } -> std::same_as<T>;
-                          };
+    requires(const K& k, T r, T h) {
+  { K::dimension } -> std::convertible_to<int>;
+  { K::support } -> std::convertible_to<double>;
+  { k.value(r, h) } -> std::same_as<T>;
+  { k.derivative(r, h) } -> std::same_as<T>;
+};
 
 /// A kernel written for spatial dimension Dim (its normalisation depends on it). A named concept rather than a
 /// parenthesized expression in ParticleSystem's requires clause, which clang-format 14 cannot format.

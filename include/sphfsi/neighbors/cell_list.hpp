@@ -36,18 +36,20 @@ class CellList {
       const T extent = domain.upper[d] - domain.lower[d];
       const auto cells = static_cast<std::int64_t>(std::floor(extent / cell_size)) + 1;
       if (cells > (std::int64_t(1) << 24) || (Dim == 3 && cells > 4096) || (Dim == 2 && cells > 65536))
-        throw InputError(fmt::format("CellList: the domain extent {} m over a cell size of {} m gives {} cells along "
-                                     "axis {}: use a smaller domain or larger particles",
-                                     extent, cell_size, cells, d));
+        throw InputError(
+            fmt::format("CellList: the domain extent {} m over a cell size of {} m gives {} cells along "
+                        "axis {}: use a smaller domain or larger particles",
+                        extent, cell_size, cells, d));
       cells_[d] = static_cast<std::int32_t>(cells) + 2;  // ghost layer on each side
       total *= static_cast<std::size_t>(cells_[d]);
     }
     // Cell indices are 32-bit (cell_of_): a 3D grid within the per-axis limit can still overflow them.
     if (total > std::numeric_limits<std::uint32_t>::max() - 1)
-      throw InputError(fmt::format("CellList: the domain over a cell size of {} m needs {} cells (ghost layers "
-                                   "included), more than the 32-bit cell index allows ({}): use a smaller domain or "
-                                   "larger particles",
-                                   cell_size, total, std::numeric_limits<std::uint32_t>::max() - 1));
+      throw InputError(
+          fmt::format("CellList: the domain over a cell size of {} m needs {} cells (ghost layers "
+                      "included), more than the 32-bit cell index allows ({}): use a smaller domain or "
+                      "larger particles",
+                      cell_size, total, std::numeric_limits<std::uint32_t>::max() - 1));
     inverse_cell_size_ = T(1) / cell_size;
     cell_size_ = cell_size;
     const std::size_t n = particles.size();

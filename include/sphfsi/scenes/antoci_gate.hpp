@@ -21,17 +21,17 @@ namespace sphfsi::scenes {
 template <Real T>
 struct AntociGate {
   // Table 1 geometry, m.
-  T column_width{T(0.1)};     ///< A
-  T column_height{T(0.14)};   ///< H
-  T gate_length{T(0.079)};    ///< L
-  T gate_thickness{T(0.005)}; ///< s
-  T tank_length{T(1.2)};      ///< downstream floor ends in a wall here (spray reaches ~0.8 m by 0.4 s)
+  T column_width{T(0.1)};      ///< A
+  T column_height{T(0.14)};    ///< H
+  T gate_length{T(0.079)};     ///< L
+  T gate_thickness{T(0.005)};  ///< s
+  T tank_length{T(1.2)};       ///< downstream floor ends in a wall here (spray reaches ~0.8 m by 0.4 s)
   // Table 2 properties.
-  T fluid_density{T(1000)};   ///< kg/m^3
-  T fluid_sound_speed{T(20)}; ///< c0, m/s (>= 10 x the largest flow speed sqrt(2 g H) = 1.66 m/s)
-  T solid_density{T(1100)};   ///< kg/m^3
-  T youngs_modulus{T(1.2e7)}; ///< E, Pa
-  T poisson_ratio{T(0.4)};    ///< nu (K = 2e7 Pa, G = 4.27e6 Pa of Table 2 give nu = 0.400)
+  T fluid_density{T(1000)};    ///< kg/m^3
+  T fluid_sound_speed{T(20)};  ///< c0, m/s (>= 10 x the largest flow speed sqrt(2 g H) = 1.66 m/s)
+  T solid_density{T(1100)};    ///< kg/m^3
+  T youngs_modulus{T(1.2e7)};  ///< E, Pa
+  T poisson_ratio{T(0.4)};     ///< nu (K = 2e7 Pa, G = 4.27e6 Pa of Table 2 give nu = 0.400)
   // Resolution.
   T particles_across{T(80)};  ///< A / dp (80: dp = 1.25 mm, 4 particle rows across the gate)
   T smoothing_ratio{T(1.3)};  ///< h / dp
@@ -51,13 +51,16 @@ struct AntociGate {
     solid_material().validate();
     const T rows = gate_thickness / dp();
     if (std::abs(rows - std::round(rows)) > T(1e-6) || rows < T(2.5))
-      throw InputError(fmt::format("AntociGate: gate_thickness / dp = {} must be a whole number >= 3 (choose "
-                                   "particles_across as a multiple of {})",
-                                   rows, column_width / gate_thickness));
+      throw InputError(
+          fmt::format("AntociGate: gate_thickness / dp = {} must be a whole number >= 3 (choose "
+                      "particles_across as a multiple of {})",
+                      rows, column_width / gate_thickness));
     const T max_speed = std::sqrt(T(2) * gravity * column_height);
     if (fluid_sound_speed < T(10) * max_speed)
-      fmt::print(stderr, "warning: AntociGate::fluid_sound_speed = {} m/s is below 10 x the largest flow speed ({:.3g} "
-                         "m/s): density errors above 1 %\n", fluid_sound_speed, T(10) * max_speed);
+      fmt::print(stderr,
+                 "warning: AntociGate::fluid_sound_speed = {} m/s is below 10 x the largest flow speed ({:.3g} "
+                 "m/s): density errors above 1 %\n",
+                 fluid_sound_speed, T(10) * max_speed);
   }
   T dp() const { return column_width / particles_across; }
   T gap() const { return dp(); }  ///< free end to floor
@@ -109,8 +112,8 @@ AntociGateIds build_antoci_gate(System& system, const AntociGate<typename System
   AntociGateIds ids;
   const T rho_s = g.solid_density;
   for_each_lattice_point<2, T>(V(x_gate, g.gap()), V(x_gate + g.gate_thickness, clamp_top), dp, [&](const V& x) {
-    const std::size_t slot = system.particles().add(Kind::solid, x, V::Zero(), rho_s, rho_s * dp * dp, res.h(),
-                                                    ids.gate_body);
+    const std::size_t slot =
+        system.particles().add(Kind::solid, x, V::Zero(), rho_s, rho_s * dp * dp, res.h(), ids.gate_body);
     if (x[1] < g.gap() + dp) ids.tip.push_back(system.particles().id[slot]);
   });
   return ids;

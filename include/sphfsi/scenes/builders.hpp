@@ -49,8 +49,8 @@ struct Resolution {
 template <class System>
 std::size_t add_fluid_block(System& system, const Vec<System::dimension, typename System::scalar_type>& lower,
                             const Vec<System::dimension, typename System::scalar_type>& upper,
-                            const Resolution<typename System::scalar_type>& res,
-                            typename System::scalar_type surface, typename System::scalar_type gravity = 9.81) {
+                            const Resolution<typename System::scalar_type>& res, typename System::scalar_type surface,
+                            typename System::scalar_type gravity = 9.81) {
   using T = typename System::scalar_type;
   constexpr int Dim = System::dimension;
   res.validate();

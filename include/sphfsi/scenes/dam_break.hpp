@@ -15,14 +15,14 @@ namespace sphfsi::scenes {
 
 template <Real T>
 struct DamBreakGeometry {
-  T column_width{T(0.057)};         ///< a, m (Martin & Moyce's 2.25 in)
-  T column_height_ratio{T(1)};      ///< n^2 = H / a (Martin & Moyce ran 1 and 2)
-  T tank_length_ratio{T(5)};        ///< tank length / a
-  T tank_height_ratio{T(2.5)};      ///< tank wall height / a
-  T particles_across{T(40)};        ///< a / dp
-  T smoothing_ratio{T(1.3)};        ///< h / dp
-  T sound_speed_factor{T(10)};      ///< c0 / sqrt(g H)
-  T gravity{T(9.81)};               ///< m/s^2
+  T column_width{T(0.057)};     ///< a, m (Martin & Moyce's 2.25 in)
+  T column_height_ratio{T(1)};  ///< n^2 = H / a (Martin & Moyce ran 1 and 2)
+  T tank_length_ratio{T(5)};    ///< tank length / a
+  T tank_height_ratio{T(2.5)};  ///< tank wall height / a
+  T particles_across{T(40)};    ///< a / dp
+  T smoothing_ratio{T(1.3)};    ///< h / dp
+  T sound_speed_factor{T(10)};  ///< c0 / sqrt(g H)
+  T gravity{T(9.81)};           ///< m/s^2
   WallModel walls{WallModel::dynamic};
 
   void validate() const {

@@ -35,10 +35,10 @@ struct WaveFlumeGeometry {
   T wall_height_ratio{T(1.5)};           ///< height of paddle and end wall over h
   T length_wavelengths{T(7)};            ///< paddle (rest position) to end wall, in wavelengths L
   FlumeAbsorber absorber{FlumeAbsorber::damping_zone};
-  T damping_wavelengths{T(1.5)};         ///< damping zone length (ending at the end wall or the beach toe), in L
-  T damping_rate{T(10)};                 ///< beta of the damping zone, 1/s
-  T beach_slope{T(0.1)};                 ///< rise over run of the beach
-  int wall_layers{3};                    ///< rows of dynamic wall particles
+  T damping_wavelengths{T(1.5)};  ///< damping zone length (ending at the end wall or the beach toe), in L
+  T damping_rate{T(10)};          ///< beta of the damping zone, 1/s
+  T beach_slope{T(0.1)};          ///< rise over run of the beach
+  int wall_layers{3};             ///< rows of dynamic wall particles
   std::vector<std::pair<Vec<2, T>, Vec<2, T>>> fluid_exclusions{};  ///< boxes (lower, upper) left without fluid, m
 
   void validate() const {
@@ -78,9 +78,9 @@ template <Real T>
 struct WaveFlumeLayout {
   static constexpr std::int32_t wall_body = 0, paddle_body = 1, beach_body = 2, first_free_body = 3;
   std::size_t fluid_particles{0}, wall_particles{0}, paddle_particles{0}, beach_particles{0};
-  T paddle_x{0};        ///< rest position of the paddle face, m
-  T end_x{0};           ///< end wall face, m
-  T still_level{0};     ///< z of the still-water surface, m
+  T paddle_x{0};     ///< rest position of the paddle face, m
+  T end_x{0};        ///< end wall face, m
+  T still_level{0};  ///< z of the still-water surface, m
 };
 
 /// Domain of the flume with a margin of 5 particle spacings (room behind the paddle for its stroke).
@@ -94,8 +94,8 @@ Domain<2, T> wave_flume_domain(const WaveFlumeGeometry<T>& g) {
 /// Fills `system` (empty, built on wave_flume_domain) with the fluid at hydrostatic rest, bed, end wall, paddle and
 /// beach. The paddle's motion is registered separately (Simulation::set_wall_motion / set_wall_kinematics).
 template <class System>
-WaveFlumeLayout<typename System::scalar_type> build_wave_flume(System& system,
-                                                               const WaveFlumeGeometry<typename System::scalar_type>& g) {
+WaveFlumeLayout<typename System::scalar_type> build_wave_flume(
+    System& system, const WaveFlumeGeometry<typename System::scalar_type>& g) {
   using T = typename System::scalar_type;
   using V = Vec<2, T>;
   static_assert(System::dimension == 2, "the wave flume scene is 2D");

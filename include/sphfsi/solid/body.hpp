@@ -35,8 +35,10 @@ class SolidBody {
     for (std::size_t i = 0; i < p.size(); ++i)
       if (p.kind[i] == Kind::solid && p.body[i] == body) ids_.push_back(p.id[i]);
     if (ids_.empty())
-      throw InputError(fmt::format("solid body {} has no particles: add particles with Kind::solid and body = {} "
-                                   "before creating its solid model", body, body));
+      throw InputError(
+          fmt::format("solid body {} has no particles: add particles with Kind::solid and body = {} "
+                      "before creating its solid model",
+                      body, body));
     std::sort(ids_.begin(), ids_.end());
     local_of_id_.assign(p.size(), -1);
     const std::size_t n = ids_.size();
@@ -71,10 +73,10 @@ class SolidBody {
   /// Body-order index of a particle id, or -1 if the particle is not in this body.
   std::int64_t local_index(std::uint32_t id) const { return id < local_of_id_.size() ? local_of_id_[id] : -1; }
   const std::vector<Vector>& reference_position() const noexcept { return reference_position_; }  ///< X, m
-  const std::vector<T>& volume() const noexcept { return volume_; }  ///< V0, m^Dim (per unit depth in 2D)
-  const std::vector<T>& mass() const noexcept { return mass_; }      ///< kg
+  const std::vector<T>& volume() const noexcept { return volume_; }       ///< V0, m^Dim (per unit depth in 2D)
+  const std::vector<T>& mass() const noexcept { return mass_; }           ///< kg
   const std::vector<T>& smoothing_length() const noexcept { return h_; }  ///< m
-  T reference_spacing() const noexcept { return spacing_; }  ///< (mean V0)^(1/Dim), m
+  T reference_spacing() const noexcept { return spacing_; }               ///< (mean V0)^(1/Dim), m
   bool is_clamped(std::size_t k) const { return clamped_[k] != 0; }
   /// Pairs within the kernel support in the reference configuration (body order).
   const detail::PairList& reference_pairs() const noexcept { return reference_pairs_; }
@@ -152,10 +154,11 @@ class SolidBody {
       if (!v[k].allFinite()) throw_blow_up(k, "velocity", time);
   }
   [[noreturn]] void throw_blow_up(std::size_t k, const std::string& quantity, T time) const {
-    throw BlowUpError(fmt::format("solid blow-up at t = {:.6g} s: body {} particle id {} has a non-finite or "
-                                  "non-physical {} (reference position [{}]); the particle set holds the last good "
-                                  "state, at the start of the failed solid step",
-                                  time, body_, ids_[k], quantity, format_vector(reference_position_[k])));
+    throw BlowUpError(
+        fmt::format("solid blow-up at t = {:.6g} s: body {} particle id {} has a non-finite or "
+                    "non-physical {} (reference position [{}]); the particle set holds the last good "
+                    "state, at the start of the failed solid step",
+                    time, body_, ids_[k], quantity, format_vector(reference_position_[k])));
   }
 
   // State in body order, advanced by the solid models.

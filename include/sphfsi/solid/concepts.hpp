@@ -29,17 +29,17 @@
 namespace sphfsi {
 
 template <class M, class System>
-concept SolidModel =
-    ParticleModel<M, System> &&
-    requires(M& m, const M& cm, std::uint32_t id, bool (*pred)(const Vec<System::dimension, typename System::scalar_type>&)) {
-      { cm.body() } -> std::convertible_to<std::int32_t>;
-      { cm.particle_ids() } -> std::convertible_to<const std::vector<std::uint32_t>&>;
-      { cm.reference_spacing() } -> std::convertible_to<typename System::scalar_type>;
-      { cm.cauchy_stress(id) } -> std::convertible_to<Mat<System::dimension, typename System::scalar_type>>;
-      { cm.solid_time_step() } -> std::convertible_to<typename System::scalar_type>;
-      { cm.max_stretch() } -> std::convertible_to<typename System::scalar_type>;
-      { cm.material() } -> std::convertible_to<const ElasticMaterial<typename System::scalar_type>&>;
-      { m.clamp_where(pred) } -> std::convertible_to<std::size_t>;
-    };
+concept SolidModel = ParticleModel<M, System> &&
+    requires(M& m, const M& cm, std::uint32_t id,
+             bool (*pred)(const Vec<System::dimension, typename System::scalar_type>&)) {
+  { cm.body() } -> std::convertible_to<std::int32_t>;
+  { cm.particle_ids() } -> std::convertible_to<const std::vector<std::uint32_t>&>;
+  { cm.reference_spacing() } -> std::convertible_to<typename System::scalar_type>;
+  { cm.cauchy_stress(id) } -> std::convertible_to<Mat<System::dimension, typename System::scalar_type>>;
+  { cm.solid_time_step() } -> std::convertible_to<typename System::scalar_type>;
+  { cm.max_stretch() } -> std::convertible_to<typename System::scalar_type>;
+  { cm.material() } -> std::convertible_to<const ElasticMaterial<typename System::scalar_type>&>;
+  { m.clamp_where(pred) } -> std::convertible_to<std::size_t>;
+};
 
 }  // namespace sphfsi

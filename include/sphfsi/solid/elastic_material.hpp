@@ -21,9 +21,9 @@ namespace sphfsi {
 /// and call validate() (the solid models do) before use.
 template <Real T>
 struct ElasticMaterial {
-  T density{T(1000)};         ///< rho0, reference density, kg/m^3
-  T youngs_modulus{T(2e6)};   ///< E, Pa
-  T poisson_ratio{T(0.3)};    ///< nu, dimensionless, (-1, 0.5)
+  T density{T(1000)};        ///< rho0, reference density, kg/m^3
+  T youngs_modulus{T(2e6)};  ///< E, Pa
+  T poisson_ratio{T(0.3)};   ///< nu, dimensionless, (-1, 0.5)
 
   /// Throws InputError naming the first invalid constant.
   void validate() const {
@@ -32,16 +32,16 @@ struct ElasticMaterial {
     require_in_open_range("ElasticMaterial::poisson_ratio (nu)", poisson_ratio, T(-1), T(0.5));
   }
 
-  T shear_modulus() const { return youngs_modulus / (T(2) * (T(1) + poisson_ratio)); }               ///< G, Pa
-  T bulk_modulus() const { return youngs_modulus / (T(3) * (T(1) - T(2) * poisson_ratio)); }          ///< K, Pa
-  T lame_lambda() const {                                                                              ///< Pa
+  T shear_modulus() const { return youngs_modulus / (T(2) * (T(1) + poisson_ratio)); }        ///< G, Pa
+  T bulk_modulus() const { return youngs_modulus / (T(3) * (T(1) - T(2) * poisson_ratio)); }  ///< K, Pa
+  T lame_lambda() const {                                                                     ///< Pa
     return youngs_modulus * poisson_ratio / ((T(1) + poisson_ratio) * (T(1) - T(2) * poisson_ratio));
   }
-  T sound_speed() const { return std::sqrt(bulk_modulus() / density); }                                ///< c0, m/s
-  T p_wave_speed() const {                                                                             ///< c_p, m/s
+  T sound_speed() const { return std::sqrt(bulk_modulus() / density); }  ///< c0, m/s
+  T p_wave_speed() const {                                               ///< c_p, m/s
     return std::sqrt((bulk_modulus() + T(4) / T(3) * shear_modulus()) / density);
   }
-  T plane_strain_modulus() const {                                                                     ///< E', Pa
+  T plane_strain_modulus() const {  ///< E', Pa
     return youngs_modulus / (T(1) - poisson_ratio * poisson_ratio);
   }
 };

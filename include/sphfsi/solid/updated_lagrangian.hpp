@@ -40,13 +40,13 @@ template <int Dim, Real T>
 struct UpdatedLagrangianParameters {
   Vec<Dim, T> gravity = default_gravity();  ///< body force per unit mass, m/s^2
   T cfl{T(0.3)};                            ///< solid step = cfl h / (c_p + |v|max), (0, 1]
-  bool sub_cycle{true};   ///< true: advance() sub-cycles and the solid does not limit the fluid step
-  T artificial_viscosity{T(0.5)};       ///< alpha, [0, 5]
-  T artificial_viscosity_beta{T(0)};    ///< beta, [0, 5]
-  T artificial_stress{T(0.3)};          ///< epsilon of Monaghan's artificial stress, [0, 1] (0: off)
-  T artificial_stress_exponent{T(4)};   ///< n of f_ab^n, [1, 10]
-  bool corrected_velocity_gradient{true};  ///< kernel-gradient correction of L (false: original GMS 2001)
-  T damping{T(0)};        ///< c_d, mass-proportional velocity damping, 1/s, >= 0
+  bool sub_cycle{true};                     ///< true: advance() sub-cycles and the solid does not limit the fluid step
+  T artificial_viscosity{T(0.5)};           ///< alpha, [0, 5]
+  T artificial_viscosity_beta{T(0)};        ///< beta, [0, 5]
+  T artificial_stress{T(0.3)};              ///< epsilon of Monaghan's artificial stress, [0, 1] (0: off)
+  T artificial_stress_exponent{T(4)};       ///< n of f_ab^n, [1, 10]
+  bool corrected_velocity_gradient{true};   ///< kernel-gradient correction of L (false: original GMS 2001)
+  T damping{T(0)};                          ///< c_d, mass-proportional velocity damping, 1/s, >= 0
   T stretch_limit{T(0)};  ///< stop with BlowUpError when max_stretch() exceeds this (0: off), else > 1
 
   static Vec<Dim, T> default_gravity() {
@@ -164,9 +164,10 @@ class UpdatedLagrangianSolid {
     if (params_.stretch_limit > T(0)) {
       const T st = body_.max_stretch();
       if (st > params_.stretch_limit)
-        throw BlowUpError(fmt::format("solid body {} at t = {:.6g} s: largest stretch between initially "
-                                      "neighbouring particles is {:.4g} > stretch_limit = {:.4g} (the body tore)",
-                                      body_.body(), time + dt, st, params_.stretch_limit));
+        throw BlowUpError(
+            fmt::format("solid body {} at t = {:.6g} s: largest stretch between initially "
+                        "neighbouring particles is {:.4g} > stretch_limit = {:.4g} (the body tore)",
+                        body_.body(), time + dt, st, params_.stretch_limit));
     }
     body_.scatter(p);
     publish(p);
@@ -231,8 +232,7 @@ class UpdatedLagrangianSolid {
   Matrix stress(std::size_t k) const { return S_[k] - pressure(k) * Matrix::Identity(); }
 
   void rebuild_pairs() {
-    pairs_ = detail::build_pair_list<Dim, T>(body_.x, body_.smoothing_length(), static_cast<T>(Kernel::support),
-                                             skin_);
+    pairs_ = detail::build_pair_list<Dim, T>(body_.x, body_.smoothing_length(), static_cast<T>(Kernel::support), skin_);
     x_at_build_ = body_.x;
   }
   /// Rebuilds the Verlet list once a particle moved more than half the skin since the last build.
@@ -306,7 +306,8 @@ class UpdatedLagrangianSolid {
       for_each_neighbor(a, [&](std::size_t b, const Vector& dx, T r, T hab) {
         const Vector grad = kernel_gradient(kernel_, dx, r, hab);
         Matrix bracket = sa + stress(b) / (rho_[b] * rho_[b]);
-        if (eps > T(0)) bracket += (R_[a] + R_[b]) * tensile_weight(kernel_.value(r, hab) / kernel_.value(dp, hab), n_exp);
+        if (eps > T(0))
+          bracket += (R_[a] + R_[b]) * tensile_weight(kernel_.value(r, hab) / kernel_.value(dp, hab), n_exp);
         const T vr = (v[a] - v[b]).dot(dx);
         if (vr < T(0) && (alpha > T(0) || beta > T(0))) {
           const T mu = hab * vr / (r * r + T(0.01) * hab * hab);
@@ -350,10 +351,10 @@ class UpdatedLagrangianSolid {
   Parameters params_;
   Kernel kernel_;
   SolidBody<Dim, T> body_;
-  std::vector<T> rho_, drho_, power_;    // density (kg/m^3), its rate, stress power V sigma:eps_dot (W)
-  T work_{0};                            // accumulated stress work sum_a int V_a sigma_a:eps_dot_a dt, J
-  std::vector<Matrix> S_, dS_, R_;       // deviatoric stress (Pa), its rate, artificial stress (m^2/s^2... /rho^2)
-  std::vector<Vector> a_int_;            // internal acceleration, m/s^2
+  std::vector<T> rho_, drho_, power_;  // density (kg/m^3), its rate, stress power V sigma:eps_dot (W)
+  T work_{0};                          // accumulated stress work sum_a int V_a sigma_a:eps_dot_a dt, J
+  std::vector<Matrix> S_, dS_, R_;     // deviatoric stress (Pa), its rate, artificial stress (m^2/s^2... /rho^2)
+  std::vector<Vector> a_int_;          // internal acceleration, m/s^2
   detail::PairList pairs_;
   std::vector<Vector> x_at_build_;
   T skin_{0};

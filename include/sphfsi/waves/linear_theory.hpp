@@ -22,14 +22,14 @@ namespace sphfsi::waves {
 /// A regular linear wave in water of constant depth: the solution of the dispersion relation and what follows.
 template <Real T>
 struct LinearWave {
-  T period;          ///< T, s
-  T depth;           ///< h, m
-  T gravity;         ///< g, m/s^2
+  T period;             ///< T, s
+  T depth;              ///< h, m
+  T gravity;            ///< g, m/s^2
   T angular_frequency;  ///< omega = 2 pi / T, rad/s
-  T wave_number;     ///< k, rad/m
-  T wavelength;      ///< L = 2 pi / k, m
-  T celerity;        ///< c = omega / k, m/s
-  T group_velocity;  ///< c_g, m/s
+  T wave_number;        ///< k, rad/m
+  T wavelength;         ///< L = 2 pi / k, m
+  T celerity;           ///< c = omega / k, m/s
+  T group_velocity;     ///< c_g, m/s
 
   T kh() const { return wave_number * depth; }
 };

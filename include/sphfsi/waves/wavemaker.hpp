@@ -50,13 +50,14 @@ class Wavemaker {
   explicit Wavemaker(const WavemakerParameters<T>& params) : params_(params) {
     params_.validate();
     wave_ = linear_wave(params_.period, params_.depth, params_.gravity);
-    const T ratio = params_.paddle == PaddleType::piston ? piston_height_to_stroke(wave_.kh())
-                                                          : flap_height_to_stroke(wave_.kh());
+    const T ratio =
+        params_.paddle == PaddleType::piston ? piston_height_to_stroke(wave_.kh()) : flap_height_to_stroke(wave_.kh());
     stroke_ = params_.wave_height / ratio;
     if (!(stroke_ < params_.depth))
-      throw InputError(fmt::format("Wavemaker: the stroke S = {} m needed for H = {} m exceeds the depth h = {} m: "
-                                   "valid wave heights are below {} m for this period and depth",
-                                   stroke_, params_.wave_height, params_.depth, ratio * params_.depth));
+      throw InputError(
+          fmt::format("Wavemaker: the stroke S = {} m needed for H = {} m exceeds the depth h = {} m: "
+                      "valid wave heights are below {} m for this period and depth",
+                      stroke_, params_.wave_height, params_.depth, ratio * params_.depth));
   }
 
   const WavemakerParameters<T>& parameters() const noexcept { return params_; }
@@ -117,8 +118,8 @@ class Wavemaker {
   PrescribedKinematics<Dim, T> flap_kinematics(T hinge_x, T hinge_z = T(0)) const {
     if (params_.paddle != PaddleType::flap)
       throw InputError("Wavemaker::flap_kinematics: this wavemaker is a piston (use piston_motion)");
-    require_in_range("Wavemaker::flap_kinematics hinge_z (m, below the still-water level)", hinge_z, T(-10) * params_.depth,
-                     params_.depth * T(0.99));
+    require_in_range("Wavemaker::flap_kinematics hinge_z (m, below the still-water level)", hinge_z,
+                     T(-10) * params_.depth, params_.depth * T(0.99));
     const Wavemaker self = *this;
     PrescribedKinematics<Dim, T> k;
     k.state = [self, hinge_x, hinge_z](const Vec<Dim, T>& reference, T t) {
