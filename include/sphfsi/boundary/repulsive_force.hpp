@@ -2,14 +2,31 @@
 // as modified by Rogers & Dalrymple (2008) (reference paper eqs 17-23). Used by repulsive walls and by the
 // RepulsiveForce coupling. The result is a force per unit mass (an acceleration) on the fluid particle:
 //   f = n R(d_perp) P(xi) eps(z, u_perp)                                  (17)
-//   R = A (1 - q) / sqrt(q),  q = d_perp / 2h,  A = 0.01 c^2 / h           (18, 19)
+//   R = A (1 - q) / sqrt(q),  q = d_perp / 2h,  A = k c^2 / h, k = 0.01    (18, 19)
 //   P = (1 + cos(pi xi / db)) / 2  for |xi| < db, else 0                   (20)
 // Eq. 20 of the reference paper prints 2 pi; with 2 pi the force vanishes midway between two boundary
 // particles. With pi (Monaghan & Kos 1999, eq. 3.4) the contributions of two neighbours sum to 1 everywhere
 // along the boundary, which is the stated purpose of P ("constant and parallel"), so sphfsi uses pi.
 //   eps = eps(z) + eps(u_perp)                                             (21-23)
+//
+// Strength. The 0.01 of eq. 19 ties A to c^2: with the usual c0 = 10 sqrt(g D) (D the deepest water) it gives
+// A = g D / h, the scale of the pressure force p / (rho h) that the wall must resist at depth D. It is kept as
+// the default `strength`; repulsive_strength_for_rest_gap() gives the strength with which a still column of depth
+// D rests with its first particle row at dp/2 from the wall (the fluid block's initial position), so a scene
+// starts in equilibrium instead of being launched off the wall. The rows j = 0, 1, ... at d_j = (j + 1/2) dp
+// (mass rho0 dp per unit wall length for each column of width dp) carry the weight of the column:
+//   rho0 dp sum_j A (1 - q_j) / sqrt(q_j) = rho0 g D,  A = k c0^2 / h
+//     =>   k = g D (h / dp) / (c0^2 sum_j (1 - q_j) / sqrt(q_j)),
+//   q_j = d_j / 2h   (q_j < 1).
+//
+// Depth factor. Eq. 22 scales the push with the depth below the local water level z0 (h0 the local depth), like
+// the hydrostatic pressure it resists. It needs both; local_depth <= 0 (the default) switches it off
+// (eps(z) = 1: the full push at every depth, which keeps the free surface a little further than dp/2 from side
+// walls but needs no knowledge of the water level). For a tank of still-water depth D: water_level = bed + D,
+// local_depth = D.
 #pragma once
 
+#include <sphfsi/core/error.hpp>
 #include <sphfsi/core/types.hpp>
 
 #include <algorithm>
@@ -25,7 +42,35 @@ struct RepulsiveForceParameters {
   T water_level{0};       ///< still-water level z0 used by eps(z); only used when local_depth > 0, m
   T local_depth{0};       ///< h0 of eq. 22; <= 0 switches the depth scaling off (eps(z) = 1), m
   int vertical_axis{1};   ///< axis of z (1 in 2D, 2 in 3D)
+  T strength{T(0.01)};    ///< coefficient k of A = k c0^2 / h (eq. 19: 0.01), > 0
+
+  /// Throws InputError naming the first parameter out of range.
+  void validate() const {
+    require_positive("RepulsiveForceParameters::boundary_spacing (db, m)", boundary_spacing);
+    require_finite("RepulsiveForceParameters::water_level (m)", water_level);
+    require_finite("RepulsiveForceParameters::local_depth (h0, m)", local_depth);
+    require_in_range("RepulsiveForceParameters::vertical_axis", vertical_axis, 0, 2);
+    require_positive("RepulsiveForceParameters::strength (k of A = k c0^2 / h)", strength);
+  }
 };
+
+/// Strength k (A = k c0^2 / h) with which a still water column of depth `depth` (m) under gravity `gravity`
+/// (m/s^2) rests on a repulsive wall with its first particle row at dp/2 from it, for sound speed c0 (m/s) and
+/// smoothing ratio h / dp (see the header comment). For c0 = 10 sqrt(g D) and h = 1.3 dp it is 0.0053.
+template <Real T>
+T repulsive_strength_for_rest_gap(T depth, T gravity, T c0, T smoothing_ratio) {
+  require_positive("repulsive_strength_for_rest_gap depth (m)", depth);
+  require_positive("repulsive_strength_for_rest_gap gravity (m/s^2)", gravity);
+  require_positive("repulsive_strength_for_rest_gap c0 (m/s)", c0);
+  require_in_range("repulsive_strength_for_rest_gap smoothing_ratio (h/dp)", smoothing_ratio, T(0.5), T(5));
+  T rows = T(0);
+  for (int j = 0;; ++j) {
+    const T q = (T(j) + T(0.5)) / (T(2) * smoothing_ratio);
+    if (q >= T(1)) break;
+    rows += (T(1) - q) / std::sqrt(q);
+  }
+  return gravity * depth * smoothing_ratio / (c0 * c0 * rows);
+}
 
 /// Depth factor eps(z) of eq. 22, z = elevation above the local water level, h0 = local depth.
 template <Real T>
@@ -54,7 +99,7 @@ inline Vec<Dim, T> repulsive_force(const Vec<Dim, T>& dx, const Vec<Dim, T>& dv,
   if (q <= T(0) || q >= T(1)) return Vec<Dim, T>::Zero();
   const T xi = (dx - d_perp * n).norm();
   if (xi >= params.boundary_spacing) return Vec<Dim, T>::Zero();
-  const T A = T(0.01) * c0 * c0 / h;                                                            // (19)
+  const T A = params.strength * c0 * c0 / h;                                                    // (19)
   const T R = A * (T(1) - q) / std::sqrt(q);                                                     // (18)
   const T P = T(0.5) * (T(1) + std::cos(std::numbers::pi_v<T> * xi / params.boundary_spacing));  // (20)
   const T eps = repulsive_depth_factor(elevation, params.local_depth) +
