@@ -48,6 +48,9 @@ struct Options {
   T end_time = -1;               // s (sag)
   T hourglass = 0.1;             // TLSPH alpha_hg
   T h_ratio = 1.3;               // h / dp
+  T cfl = 0.3;                   // solid CFL number
+  bool fixed_clamp = false;        // TLSPH: hold the wall part at rest instead of the reflected clamp
+  bool linear_correction = false;  // TLSPH: Bonet-Lok gradient (exact for linear fields only) everywhere
   bool uncorrected = false;      // ULSPH: original GMS 2001 velocity gradient (no kernel-gradient correction)
   T viscosity = -1;              // artificial viscosity alpha (default 0 TL, 0.5 UL)
   std::string output = "oscillating_plate.csv";
@@ -67,8 +70,11 @@ void print_help() {
       "  --damping c         velocity damping, 1/s (default 0; the first-mode omega with --sag)\n"
       "  --end t             end time, s (sag, default 12 first-mode periods)\n"
       "  --hourglass a       TLSPH hourglass coefficient (default 0.1)\n"
+      "  --fixed-clamp       TLSPH: wall part held at rest (default: clamped by odd reflection at x = 0)\n"
+      "  --linear-correction TLSPH: Bonet-Lok gradient correction only (no quadratic correction)\n"
       "  --uncorrected       ULSPH: velocity gradient without kernel-gradient correction (original GMS 2001)\n"
       "  --h-ratio r         smoothing length over particle spacing (default 1.3)\n"
+      "  --cfl c             solid CFL number (default 0.3)\n"
       "  --viscosity a       artificial viscosity alpha (default 0 for tl, 0.5 for ul)\n"
       "  --output file.csv   time series t, tip deflection, energies, max stretch\n");
 }
@@ -94,7 +100,10 @@ Options parse(int argc, char** argv) {
     else if (a == "--end") o.end_time = std::stod(value());
     else if (a == "--hourglass") o.hourglass = std::stod(value());
     else if (a == "--h-ratio") o.h_ratio = std::stod(value());
+    else if (a == "--cfl") o.cfl = std::stod(value());
     else if (a == "--uncorrected") o.uncorrected = true;
+    else if (a == "--linear-correction") o.linear_correction = true;
+    else if (a == "--fixed-clamp") o.fixed_clamp = true;
     else if (a == "--viscosity") o.viscosity = std::stod(value());
     else if (a == "--output") o.output = value();
     else throw sphfsi::InputError(fmt::format("unknown option {} (see --help)", a));
@@ -128,12 +137,17 @@ int run(const Options& o) {
   typename Model::Parameters params{};
   params.gravity = o.sag ? Vector(0, -9.81) : Vector(0, 0);
   params.artificial_viscosity = o.viscosity;
+  params.cfl = o.cfl;
   params.damping = o.damping >= 0 ? o.damping : (o.sag ? omega : T(0));
   if constexpr (requires { params.hourglass; }) params.hourglass = o.hourglass;
+  if constexpr (requires { params.quadratic_correction; }) params.quadratic_correction = !o.linear_correction;
   if constexpr (requires { params.corrected_velocity_gradient; }) params.corrected_velocity_gradient = !o.uncorrected;
   Model solid(system, 0, material, params);
   static_assert(sphfsi::SolidModel<Model, System>);
-  const std::size_t clamped = solid.clamp_where([](const Vector& X) { return X.x() < 0; });
+  std::size_t clamped = 0;
+  if constexpr (requires { solid.clamp_by_reflection(Vector(0, 0), Vector(1, 0)); })
+    if (!o.fixed_clamp) clamped = solid.clamp_by_reflection(Vector(0, 0), Vector(1, 0));
+  if (!clamped) clamped = solid.clamp_where([](const Vector& X) { return X.x() < 0; });
 
   // Initial velocity of the first bending mode (zero in the sag case).
   auto& p = system.particles();
@@ -202,26 +216,27 @@ int run(const Options& o) {
                std::abs(w_series.back() - w_series[w_series.size() - 2]) / sample);
     return 0;
   }
-  // Upward zero crossings (linear interpolation) -> period; positive peaks -> decay per period.
-  std::vector<T> up, peaks;
-  for (std::size_t i = 1; i < w_series.size(); ++i) {
-    if (w_series[i - 1] < 0 && w_series[i] >= 0)
-      up.push_back(t_series[i - 1] + (t_series[i] - t_series[i - 1]) * (-w_series[i - 1]) /
-                                         (w_series[i] - w_series[i - 1]));
+  // Zero crossings in both directions after the start (linear interpolation) -> half periods; positive
+  // peaks -> decay per period. The first sample (w = 0 exactly, at t = 0) is not a crossing.
+  std::vector<T> crossings, peaks;
+  for (std::size_t i = 2; i < w_series.size(); ++i) {
+    if ((w_series[i - 1] < 0) != (w_series[i] < 0))
+      crossings.push_back(t_series[i - 1] + (t_series[i] - t_series[i - 1]) * (-w_series[i - 1]) /
+                                                (w_series[i] - w_series[i - 1]));
     if (i + 1 < w_series.size() && w_series[i] > 0 && w_series[i] >= w_series[i - 1] && w_series[i] > w_series[i + 1])
       peaks.push_back(w_series[i]);
   }
-  // The first downward crossing from the initial state gives one more half-period; use full upward periods.
-  if (up.size() < 2) {
+  if (crossings.size() < 3) {
     fmt::print("not enough oscillations to measure a period (run longer: --periods)\n");
     return 1;
   }
-  const T measured = (up.back() - up.front()) / T(up.size() - 1);
+  const T measured = 2 * (crossings.back() - crossings.front()) / T(crossings.size() - 1);
+  const std::size_t half_periods = crossings.size() - 1;
   T decay = 0;
   if (peaks.size() >= 2) decay = 1 - std::pow(peaks.back() / peaks.front(), 1 / T(peaks.size() - 1));
-  fmt::print("V_f = {} | period {:.5f} s (from {} periods) | Euler-Bernoulli {:.5f} s | error {:+.2f} % | "
+  fmt::print("V_f = {} | period {:.5f} s (from {} half periods) | Euler-Bernoulli {:.5f} s | error {:+.2f} % | "
              "first amplitude {:.4e} m | decay per period {:.2f} % | max stretch {:.4f}\n",
-             o.vf, measured, up.size() - 1, period, 100 * (measured - period) / period,
+             o.vf, measured, half_periods, period, 100 * (measured - period) / period,
              peaks.empty() ? 0.0 : peaks.front(), 100 * decay, stretch_max);
   return 0;
 }
