@@ -270,7 +270,7 @@ class WcsphFluid {
       const T mu = h * vr * inverse_distance2;
       const T continuity = grad_factor * vr;  // v_ab . grad_a W
       drho += mass[b] * continuity;
-      partner.add_density_rate(b, ma * continuity);
+      T drho_b = ma * continuity;
       const T rho_b = rho[b];
       const T pi_ab = vr < T(0) ? -alpha * (ca + c[b]) * mu / (rho_a + rho_b) : T(0);
       const T force = pa + pressure_term[b] + pi_ab;
@@ -293,7 +293,7 @@ class WcsphFluid {
           const T diffusion =
               delta * h * c0 * T(2) * ((rho_a - rho_b) - hydrostatic) * grad_factor * r2 * inverse_distance2;
           drho += volume[b] * diffusion;
-          partner.add_density_rate(b, -vol_a * diffusion);
+          drho_b -= vol_a * diffusion;
         }
         if (eps_xsph > T(0)) {
           const T w = eps_xsph * kernel.value(r, h) / (T(0.5) * (rho_a + rho_b));
@@ -301,6 +301,7 @@ class WcsphFluid {
           partner.add_xsph(b, (ma * w) * vab);
         }
       }
+      partner.add_density_rate(b, drho_b);
     });
     p.acceleration[a] += acc;
     p.density_rate[a] += drho;
