@@ -58,8 +58,13 @@ int run(const Options& opt, const Coupling& coupling) {
   const scenes::AntociGateIds ids = scenes::build_antoci_gate(system, scene);
 
   Solid solid = make_gate<Solid>(system, scene, ids.gate_body);
-  const Scalar clamp_y = scene.gap() + scene.gate_length;
-  solid.clamp_where([&](const Vec<2, Scalar>& X) { return X[1] > clamp_y; });
+  // The clamp: the rows above the clamp plane are embedded in the rigid wall. The total-Lagrangian model moves them
+  // as the mirror image of the free part (the clamp acts on the wall plane); the other model holds them at rest.
+  const Scalar clamp_y = scene.clamp_height();
+  if constexpr (requires { solid.clamp_by_reflection(Vec<2, Scalar>(), Vec<2, Scalar>()); })
+    solid.clamp_by_reflection(Vec<2, Scalar>(0, clamp_y), Vec<2, Scalar>(0, -1));
+  else
+    solid.clamp_where([&](const Vec<2, Scalar>& X) { return X[1] > clamp_y; });
   using Gate = CoupledBody<Coupling, Solid>;
   Simulation<System, SymplecticVerlet, Gate> sim(system, scene.fluid(), {}, Gate(coupling, std::move(solid)));
 

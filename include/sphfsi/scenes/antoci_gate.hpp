@@ -64,6 +64,8 @@ struct AntociGate {
   }
   T dp() const { return column_width / particles_across; }
   T gap() const { return dp(); }  ///< free end to floor
+  /// Height of the clamp plane: the gate's free part spans round(L/dp) particle rows above the gap.
+  T clamp_height() const { return gap() + std::round(gate_length / dp()) * dp(); }
   ElasticMaterial<T> solid_material() const {
     ElasticMaterial<T> m;
     m.density = solid_density;
@@ -91,7 +93,7 @@ struct AntociGateIds {
 };
 
 /// Fills an empty 2D system with the water column, the tank walls, the rigid wall above the gate and the gate
-/// (solid particles of body 1, to be clamped where y > gap + L).
+/// (solid particles of body 1, to be clamped above clamp_height()).
 template <class System>
 AntociGateIds build_antoci_gate(System& system, const AntociGate<typename System::scalar_type>& g) {
   using T = typename System::scalar_type;
@@ -103,7 +105,7 @@ AntociGateIds build_antoci_gate(System& system, const AntociGate<typename System
   add_fluid_block(system, V(0, 0), V(g.column_width, g.column_height), res, g.column_height, g.gravity);
   add_box_walls(system, V(0, 0), V(g.tank_length, top), res, WallModel::dynamic, 3, 0);
   // Rigid wall above the gate's clamp: wall particles on the gate's lattice.
-  const T clamp_top = g.gap() + g.gate_length + T(g.clamp_rows) * dp;
+  const T clamp_top = g.clamp_height() + T(g.clamp_rows) * dp;
   const T rho_w = system.eos().reference_density();
   for_each_lattice_point<2, T>(V(x_gate, clamp_top), V(x_gate + g.gate_thickness, top), dp, [&](const V& x) {
     system.particles().add(Kind::wall, x, V::Zero(), rho_w, rho_w * dp * dp, res.h(), 0);
