@@ -7,7 +7,7 @@
 set -euo pipefail
 bench=${1:-build/release/benchmarks/bench_dam_break_throughput}
 repeats=${REPEATS:-1}
-echo "precision,threads,particles,steps,seconds,million_particle_steps_per_s"
+echo "precision,threads,particles,steps,seconds,million_particle_steps_per_s,cpu_seconds,million_particle_steps_per_cpu_s"
 for ((k = 0; k < repeats; ++k)); do
   for res in 90 190 390; do
     steps=$(( res == 90 ? 400 : (res == 190 ? 100 : 25) ))
