@@ -161,6 +161,10 @@ int main(int argc, char** argv) try {
   RepulsiveForce<Scalar> repulsive;
   repulsive.water_level = opt.scene.column_height;
   repulsive.local_depth = opt.scene.column_height;
+  // Strength k of eq. 19 such that the still column is in equilibrium with the gate at t = 0 (first fluid row at
+  // dp from the gate's surface particles): 0.0036 for c0 = 20 m/s, instead of the paper's 0.01 which kicks the gate.
+  repulsive.strength = repulsive_strength_for_rest_gap(opt.scene.column_height, opt.scene.gravity,
+                                                       opt.scene.fluid_sound_speed, opt.scene.smoothing_ratio, 1.0);
   const bool tl = solid == "tl";
   if (coupling == "stress")
     return tl ? run<TotalLagrangian>(opt, StressContinuity<Scalar>{})

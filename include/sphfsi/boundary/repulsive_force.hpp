@@ -57,15 +57,19 @@ struct RepulsiveForceParameters {
 /// Strength k (A = k c0^2 / h) with which a still water column of depth `depth` (m) under gravity `gravity`
 /// (m/s^2) rests on a repulsive wall with its first particle row at dp/2 from it, for sound speed c0 (m/s) and
 /// smoothing ratio h / dp (see the header comment). For c0 = 10 sqrt(g D) and h = 1.3 dp it is 0.0053.
+/// first_row is the distance of the first fluid row from the boundary particles in units of dp: 1/2 for a wall
+/// line, 1 for the surface particles of an SPH solid (whose surface lies dp/2 outside its particle centres). With
+/// the depth factor eps(z) = |z| / D of eq. 22 the same strength balances the hydrostatic load on a vertical wall.
 template <Real T>
-T repulsive_strength_for_rest_gap(T depth, T gravity, T c0, T smoothing_ratio) {
+T repulsive_strength_for_rest_gap(T depth, T gravity, T c0, T smoothing_ratio, T first_row = T(0.5)) {
+  require_in_range("repulsive_strength_for_rest_gap first_row (in dp)", first_row, T(0.1), T(2));
   require_positive("repulsive_strength_for_rest_gap depth (m)", depth);
   require_positive("repulsive_strength_for_rest_gap gravity (m/s^2)", gravity);
   require_positive("repulsive_strength_for_rest_gap c0 (m/s)", c0);
   require_in_range("repulsive_strength_for_rest_gap smoothing_ratio (h/dp)", smoothing_ratio, T(0.5), T(5));
   T rows = T(0);
   for (int j = 0;; ++j) {
-    const T q = (T(j) + T(0.5)) / (T(2) * smoothing_ratio);
+    const T q = (T(j) + first_row) / (T(2) * smoothing_ratio);
     if (q >= T(1)) break;
     rows += (T(1) - q) / std::sqrt(q);
   }

@@ -23,10 +23,12 @@ struct RepulsiveForce {
   T local_depth{0};   ///< h0 of eq. 22; <= 0: eps(z) = 1 (no depth scaling), m
   T sound_speed{0};   ///< c0 used in A = 0.01 c0^2 / h (19) and eps(u) (23); 0: the fluid EOS's c0, m/s
   T range_factor{1};  ///< scales the boundary spacing db used in P(xi) (eq. 20), [0.5, 3]
+  T strength{T(0.01)};  ///< k of A = k c0^2 / h (eq. 19: 0.01); see repulsive_strength_for_rest_gap(), > 0
 
   void validate() const {
     require_non_negative("RepulsiveForce::sound_speed (m/s)", sound_speed);
     require_in_range("RepulsiveForce::range_factor", range_factor, T(0.5), T(3));
+    require_positive("RepulsiveForce::strength (k of A = k c0^2 / h)", strength);
   }
 
   template <class System, class Solid>
@@ -42,6 +44,7 @@ struct RepulsiveForce {
     params.water_level = water_level;
     params.local_depth = local_depth;
     params.vertical_axis = up;
+    params.strength = strength;
     const T c0 = sound_speed > T(0) ? sound_speed : system.eos().reference_sound_speed();
     for (std::size_t k = 0; k < ids.size(); ++k) {
       if (!surface[k]) continue;
