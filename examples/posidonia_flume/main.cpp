@@ -1,0 +1,383 @@
+// sphfsi example: Posidonia plants in the reference paper's wave flume (issue 5 part 4; paper, Results, Fig. 8).
+//
+// Still-water depth h = 0.2 m, piston paddle at x = 0, one plant (or a meadow of N plants) clamped in the bed from
+// x = 1.2 m, gauges at x = 0.6, 1.0, 1.3 and 1.7 m, a damping zone beyond x = 2 m (scenes/posidonia_flume.hpp).
+// The plants are total-Lagrangian elastic blades coupled to the fluid by the paper's retained repulsive-force
+// coupling (eqs 17-23) with the depth factor eps(z) referred to the still-water level. The same flume is run
+// with and without plants at equal resolution (the empty flume loses 11-15 % of the height per wavelength at
+// these resolutions, docs/flume.md, so the plants' effect is the difference of the two runs).
+// Output (--output DIR): DIR/plants and DIR/empty with gauges.csv, wave_heights.csv, (plants) tips.csv and VTK
+// snapshots; DIR/comparison.csv (H at each gauge, both runs) and DIR/posidonia_flume.png. See docs/posidonia.md.
+#include <sphfsi/analysis/zero_crossing.hpp>
+#include <sphfsi/coupling/coupled_body.hpp>
+#include <sphfsi/coupling/repulsive_force.hpp>
+#include <sphfsi/eos/tait.hpp>
+#include <sphfsi/integrators/simulation.hpp>
+#include <sphfsi/integrators/symplectic.hpp>
+#include <sphfsi/io/command_line.hpp>
+#include <sphfsi/io/csv.hpp>
+#include <sphfsi/io/progress.hpp>
+#include <sphfsi/io/vtk_writer.hpp>
+#include <sphfsi/kernel/wendland_c2.hpp>
+#include <sphfsi/scenes/gate_tip_comparison.hpp>
+#include <sphfsi/scenes/posidonia_flume.hpp>
+#include <sphfsi/solid/total_lagrangian.hpp>
+#include <sphfsi/waves/gauges.hpp>
+#include <sphfsi/waves/wavemaker.hpp>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+using namespace sphfsi;
+
+struct Options {
+  scenes::PosidoniaFlume<double> scene;
+  double alpha{0.01}, delta{0.1};
+  double waves_analysed{4};
+  double end_time{0};
+  double snapshots{0};
+  bool run_plants{true}, run_empty{true};
+  std::filesystem::path out;
+  std::filesystem::path empty_from;  // reuse DIR/empty/wave_heights.csv of an earlier run instead of the empty run
+};
+
+/// What one run measured.
+struct CaseResult {
+  std::vector<double> height, height_std, period;  // per gauge (NaN where no complete wave)
+  std::vector<double> tip_dx_amplitude, tip_dz_amplitude, tip_dx_mean, tip_dz_mean;  // per plant, m
+  std::size_t fluid{0}, wall{0}, solid{0}, steps{0}, solid_sub_steps{0}, fluid_inside_max{0};
+  double wall_seconds{0}, end_time{0}, reached{0}, max_stretch{1};
+  std::string failure;
+};
+
+template <class T>
+scenes::PosidoniaFlume<T> converted(const scenes::PosidoniaFlume<double>& s) {
+  scenes::PosidoniaFlume<T> c;
+  c.depth = T(s.depth), c.wave_height = T(s.wave_height), c.period = T(s.period), c.ramp_periods = T(s.ramp_periods);
+  c.particles_per_depth = T(s.particles_per_depth), c.sound_speed_factor = T(s.sound_speed_factor);
+  c.absorber_start = T(s.absorber_start), c.damping_wavelengths = T(s.damping_wavelengths);
+  c.damping_rate = T(s.damping_rate);
+  c.gauges.assign(s.gauges.begin(), s.gauges.end());
+  c.plants = s.plants, c.first_plant_x = T(s.first_plant_x), c.spacing = T(s.spacing);
+  c.height_ratio = T(s.height_ratio), c.blade = s.blade, c.blade_rows = s.blade_rows, c.clamp_rows = s.clamp_rows;
+  c.real_density = T(s.real_density), c.real_youngs_modulus = T(s.real_youngs_modulus);
+  c.real_thickness = T(s.real_thickness), c.poisson_ratio = T(s.poisson_ratio);
+  c.equivalent_bulk_modulus = T(s.equivalent_bulk_modulus);
+  return c;
+}
+
+template <class T, bool WithPlants>
+CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
+  using System = ParticleSystem<2, T, WendlandC2<2>, Tait<T>>;
+  using Solid = TotalLagrangianSolid<System>;
+  using Plant = CoupledBody<RepulsiveForce<T>, Solid>;
+  using Solver = std::conditional_t<WithPlants, Simulation<System, SymplecticVerlet, waves::DampingZone<T>, Plant>,
+                                    Simulation<System, SymplecticVerlet, waves::DampingZone<T>>>;
+  scenes::PosidoniaFlume<T> scene = converted<T>(o.scene);
+  if (!WithPlants) scene.plants = 0;
+  const auto g = scene.flume();
+  System system(scenes::wave_flume_domain(g), Tait<T>(1000, g.sound_speed()));
+  const auto layout = scenes::build_posidonia_flume(system, scene);
+  FluidParameters<2, T> fluid = scenes::wave_flume_fluid(g);
+  fluid.artificial_viscosity = T(o.alpha);
+  fluid.density_diffusion = T(o.delta);
+
+  auto make_solver = [&]() {
+    if constexpr (WithPlants) {
+      typename Solid::Parameters params;
+      params.gravity = Vec<2, T>(0, -g.wave.gravity);
+      params.stretch_limit = T(3);
+      Solid blades(system, layout.plant_body, scene.blade_material(), params);
+      blades.clamp_by_reflection(Vec<2, T>(0, 0), Vec<2, T>(0, 1));  // embedded rows: odd images about the bed
+      // eps(z) of eq. 22 referred to the still-water level, as for the hydrostatic pressure it balances
+      RepulsiveForce<T> coupling;
+      coupling.water_level = scene.depth;
+      coupling.local_depth = scene.depth;
+      return Solver(system, fluid, {}, g.damping_zone(), Plant(coupling, std::move(blades)));
+    } else {
+      return Solver(system, fluid, {}, g.damping_zone());
+    }
+  };
+  Solver sim = make_solver();
+  const waves::Wavemaker<T> maker(g.wave);
+  sim.set_wall_motion(layout.flume.paddle_body, maker.template piston_motion<2>());
+  const auto wave = maker.wave();
+
+  CaseResult r;
+  r.fluid = system.particles().count(Kind::fluid);
+  r.wall = system.particles().count(Kind::wall);
+  r.solid = system.particles().count(Kind::solid);
+  const double x_last = double(*std::max_element(scene.gauges.begin(), scene.gauges.end()));
+  r.end_time = o.end_time > 0 ? o.end_time
+                              : double(maker.ramp_time()) + x_last / double(wave.group_velocity) +
+                                    (o.waves_analysed + 1.5) * double(wave.period);
+  fmt::print("--- {} ({} fluid, {} wall, {} solid particles; end time {:.2f} s)\n",
+             WithPlants ? fmt::format("{} plant(s)", scene.plants) : std::string("empty flume"), r.fluid, r.wall,
+             r.solid, r.end_time);
+
+  std::filesystem::create_directories(dir);
+  waves::WaveGauges<T> gauges(scene.gauges, layout.flume.still_level, g.dp());
+  gauges.open(dir / "gauges.csv",
+              fmt::format("posidonia_flume ({}): eta (m) at x (m) = column suffix; h = {} m, T = {} s, H = {} m, "
+                          "h/dp = {}",
+                          WithPlants ? fmt::format("{} plants", scene.plants) : "empty", double(scene.depth),
+                          double(scene.period), double(scene.wave_height), double(scene.particles_per_depth)));
+  // tips: mean displacement of each plant's top row from its rest position
+  std::vector<std::string> tip_columns{"t"};
+  for (std::size_t k = 0; k < layout.tips.size(); ++k) {
+    tip_columns.push_back(fmt::format("dx_{}", k));
+    tip_columns.push_back(fmt::format("dz_{}", k));
+  }
+  std::optional<io::CsvWriter> tips_csv;
+  if (WithPlants)
+    tips_csv.emplace(dir / "tips.csv", tip_columns,
+                     fmt::format("plant tip (top row mean) displacement (m); plant centre lines x = {} m",
+                                 fmt::join(layout.plant_x, ", ")));
+  auto tip_position = [&](const System& s, std::size_t k) {
+    Vec<2, T> c = Vec<2, T>::Zero();
+    for (auto id : layout.tips[k]) c += s.particles().position[s.particles().slot_of_id(id)];
+    return Vec<2, T>(c / T(layout.tips[k].size()));
+  };
+  std::vector<Vec<2, T>> tip0;
+  for (std::size_t k = 0; k < layout.tips.size(); ++k) tip0.push_back(tip_position(system, k));
+  std::vector<double> times;
+  std::vector<std::vector<double>> tip_dx(layout.tips.size()), tip_dz(layout.tips.size());
+
+  io::VtkSeriesWriter vtk(dir, "posidonia_flume");
+  const double sample_every = double(scene.period) / 40;
+  double next_sample = 0, next_snapshot = 0;
+  io::ProgressReporter progress(r.end_time);
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    sim.run(T(r.end_time), [&](Solver& sm) {
+      progress(sm);
+      if (double(sm.time()) + 1e-9 >= next_sample) {
+        gauges.sample(sm.system(), sm.time());
+        if constexpr (WithPlants) {
+          std::vector<double> row{double(sm.time())};
+          times.push_back(double(sm.time()));
+          for (std::size_t k = 0; k < layout.tips.size(); ++k) {
+            const Vec<2, T> d = tip_position(sm.system(), k) - tip0[k];
+            row.push_back(double(d[0]));
+            row.push_back(double(d[1]));
+            tip_dx[k].push_back(double(d[0]));
+            tip_dz[k].push_back(double(d[1]));
+          }
+          tips_csv->write_row(row);
+          r.max_stretch = std::max(r.max_stretch, double(sm.template model<1>().solid().max_stretch()));
+          r.fluid_inside_max =
+              std::max(r.fluid_inside_max, scenes::fluid_particles_inside_solid(sm.system(), layout.plant_body));
+        }
+        next_sample += sample_every;
+      }
+      if (o.snapshots > 0 && double(sm.time()) + 1e-9 >= next_snapshot) {
+        vtk.write(sm.system().particles(), sm.time());
+        next_snapshot += r.end_time / o.snapshots;
+      }
+    });
+  } catch (const BlowUpError& e) {
+    r.failure = e.what();
+    fmt::print(stderr, "run stopped: {}\n", r.failure);
+    vtk.write(system.particles(), sim.time());
+  }
+  progress.finish(sim);
+  r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  r.steps = sim.step_count();
+  r.reached = double(sim.time());
+  if constexpr (WithPlants) r.solid_sub_steps = sim.template model<1>().solid().sub_step_total();
+  fmt::print("{} steps to t = {:.2f} s, {:.1f} s wall ({:.2f} million particle-steps/s)\n", r.steps, r.reached,
+             r.wall_seconds, double(system.size()) * double(r.steps) / r.wall_seconds * 1e-6);
+
+  // zero up-crossing heights once the full-amplitude waves have reached each gauge
+  const std::vector<double> t(gauges.times().begin(), gauges.times().end());
+  io::CsvWriter heights(dir / "wave_heights.csv", {"x", "H", "H_std", "T", "waves"});
+  for (std::size_t i = 0; i < scene.gauges.size(); ++i) {
+    const std::vector<double> eta(gauges.series(i).begin(), gauges.series(i).end());
+    const double x = double(scene.gauges[i]);
+    const double from = double(maker.ramp_time()) + x / double(wave.group_velocity) + double(wave.period);
+    double H = std::numeric_limits<double>::quiet_NaN(), s = H, T_ = H, n = 0;
+    try {
+      const auto w = analysis::zero_crossing_analysis(t, eta, from, r.reached);
+      H = w.mean_height, s = w.height_std, T_ = w.mean_period, n = double(w.count());
+    } catch (const InputError& e) {
+      fmt::print("gauge x = {:.2f} m: no complete wave after t = {:.2f} s\n", x, from);
+    }
+    r.height.push_back(H), r.height_std.push_back(s), r.period.push_back(T_);
+    heights.write_row({x, H, s, T_, n});
+  }
+  // tip excursion: half the peak-to-peak displacement once the full waves have reached the plant
+  for (std::size_t k = 0; k < layout.tips.size(); ++k) {
+    const double from = double(maker.ramp_time()) + double(layout.plant_x[k]) / double(wave.group_velocity) +
+                        double(wave.period);
+    double lo_x = 1e9, hi_x = -1e9, lo_z = 1e9, hi_z = -1e9, sum_x = 0, sum_z = 0;
+    std::size_t n = 0;
+    for (std::size_t j = 0; j < times.size(); ++j) {
+      if (times[j] < from) continue;
+      lo_x = std::min(lo_x, tip_dx[k][j]), hi_x = std::max(hi_x, tip_dx[k][j]);
+      lo_z = std::min(lo_z, tip_dz[k][j]), hi_z = std::max(hi_z, tip_dz[k][j]);
+      sum_x += tip_dx[k][j], sum_z += tip_dz[k][j], ++n;
+    }
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    r.tip_dx_amplitude.push_back(n ? 0.5 * (hi_x - lo_x) : nan);
+    r.tip_dz_amplitude.push_back(n ? 0.5 * (hi_z - lo_z) : nan);
+    r.tip_dx_mean.push_back(n ? sum_x / double(n) : nan);
+    r.tip_dz_mean.push_back(n ? sum_z / double(n) : nan);
+  }
+  return r;
+}
+
+template <class T>
+int run(const Options& o) {
+  const auto scene = converted<T>(o.scene);
+  const auto g = scene.flume();
+  const waves::Wavemaker<T> maker(g.wave);
+  const auto w = maker.wave();
+  const auto m = scene.blade_material();
+  fmt::print(
+      "Posidonia flume ({}): h = {} m, T = {} s, target H = {} m; kh = {:.3f}, L = {:.3f} m, c_g = {:.3f} m/s, "
+      "piston stroke S = {:.4f} m\n",
+      sizeof(T) == 4 ? "float" : "double", double(scene.depth), double(scene.period), double(scene.wave_height),
+      double(w.kh()), double(w.wavelength), double(w.group_velocity), double(maker.stroke()));
+  fmt::print("resolution: dp = {:.4f} m (h/dp = {}, H/dp = {:.2f}, L/dp = {:.0f}); flume {:.2f} m, damping zone "
+             "{:.2f} ... {:.2f} m; c0 = {:.2f} m/s\n",
+             double(scene.dp()), double(scene.particles_per_depth), double(scene.wave_height / scene.dp()),
+             double(w.wavelength / scene.dp()), double(g.length()), double(g.damping_zone().x_start),
+             double(g.damping_zone().x_end), double(g.sound_speed()));
+  fmt::print("plants: {} at x = {} m, blade {} model: length l = {:.3f} m ({} rows, l/h = {:.3f}), thickness t_m = "
+             "{:.4f} m ({} rows);\n  rho_m = {:.4g} kg/m^3, E_m = {:.4g} Pa, nu_m = {:.5g} (K_m = {:.4g} Pa), "
+             "P-wave speed {:.3g} m/s; bending stiffness per width {:.3g} N m (real E t^3/12 = {:.3g} N m, "
+             "ratio {:.4g}); mass per length {:.4g} kg/m^2 (real {:.4g})\n",
+             scene.plants, fmt::join(scene.plant_x(), ", "), scene.blade == scenes::BladeModel::scaled ? "scaled" :
+             "equivalent", double(scene.blade_length()), scene.blade_length_rows(),
+             double(scene.blade_length() / scene.depth), double(scene.blade_thickness()), scene.blade_rows,
+             double(m.density), double(m.youngs_modulus), double(m.poisson_ratio), double(m.bulk_modulus()),
+             double(m.p_wave_speed()), double(scene.model_bending_stiffness()), double(scene.real_bending_stiffness()),
+             double(scene.model_bending_stiffness() / scene.real_bending_stiffness()),
+             double(m.density * scene.blade_thickness()), double(scene.real_density * scene.real_thickness));
+
+  CaseResult with, without;
+  if (o.run_plants) with = run_case<T, true>(o, o.out / "plants");
+  if (o.run_empty) without = run_case<T, false>(o, o.out / "empty");
+  const bool have_empty = o.run_empty || !o.empty_from.empty();
+  if (!o.run_empty && have_empty) {  // the empty flume of an earlier run at the same waves and resolution
+    const auto table = io::read_csv(o.empty_from / "empty" / "wave_heights.csv");
+    const auto x = table.column("x");
+    without.height = table.column("H");
+    if (x.size() != scene.gauges.size())
+      throw InputError(fmt::format("--empty-from {}: {} gauges there, {} here", o.empty_from.string(), x.size(),
+                                   scene.gauges.size()));
+    for (std::size_t i = 0; i < x.size(); ++i)
+      if (std::abs(x[i] - double(scene.gauges[i])) > 1e-6)
+        throw InputError(fmt::format("--empty-from {}: gauge {} at x = {} m, here at {} m", o.empty_from.string(), i,
+                                     x[i], double(scene.gauges[i])));
+    fmt::print("empty flume heights from {} (same waves and resolution assumed)\n", o.empty_from.string());
+  }
+
+  const std::size_t n = scene.gauges.size();
+  io::CsvWriter comparison(o.out / "comparison.csv", {"x", "H_plants", "H_empty", "relative_change"});
+  fmt::print("\ngauge x (m)   H with plants (m)   H empty (m)   change\n");
+  for (std::size_t i = 0; i < n; ++i) {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    const double a = o.run_plants ? with.height[i] : nan, b = have_empty ? without.height[i] : nan;
+    fmt::print("  {:8.2f}   {:17.5f}   {:11.5f}   {:+6.1f} %\n", double(scene.gauges[i]), a, b, 100 * (a / b - 1));
+    comparison.write_row({double(scene.gauges[i]), a, b, a / b - 1});
+  }
+  if (o.run_plants) {
+    fmt::print("tip excursion (half peak-to-peak after the full waves arrive) and mean displacement:\n");
+    for (std::size_t k = 0; k < with.tip_dx_amplitude.size(); ++k)
+      fmt::print("  plant {} at x = {:.3f} m: |dx| {:.2f} mm, |dz| {:.2f} mm; mean dx {:+.2f} mm, dz {:+.2f} mm\n", k,
+                 double(scene.plant_x()[k]), 1e3 * with.tip_dx_amplitude[k], 1e3 * with.tip_dz_amplitude[k],
+                 1e3 * with.tip_dx_mean[k], 1e3 * with.tip_dz_mean[k]);
+    fmt::print("plants run: {} + {} + {} particles, {} steps, {} solid sub-steps, {:.1f} s wall; max stretch {:.3f}, "
+               "fluid particles inside the blades (max) {}{}\n",
+               with.fluid, with.wall, with.solid, with.steps, with.solid_sub_steps, with.wall_seconds,
+               with.max_stretch, with.fluid_inside_max, with.failure.empty() ? "" : "; FAILED: " + with.failure);
+  }
+  if (o.run_empty)
+    fmt::print("empty run: {} + {} particles, {} steps, {:.1f} s wall{}\n", without.fluid, without.wall, without.steps,
+               without.wall_seconds, without.failure.empty() ? "" : "; FAILED: " + without.failure);
+  io::CsvWriter summary(o.out / "summary.csv",
+                        {"run", "fluid", "wall", "solid", "steps", "solid_sub_steps", "wall_s", "reached_s",
+                         "max_stretch", "fluid_inside_max", "failed"});
+  if (o.run_plants)
+    summary.write_row({1, double(with.fluid), double(with.wall), double(with.solid), double(with.steps),
+                       double(with.solid_sub_steps), with.wall_seconds, with.reached, with.max_stretch,
+                       double(with.fluid_inside_max), with.failure.empty() ? 0.0 : 1.0});
+  if (o.run_empty)
+    summary.write_row({0, double(without.fluid), double(without.wall), 0, double(without.steps), 0,
+                       without.wall_seconds, without.reached, 1, 0, without.failure.empty() ? 0.0 : 1.0});
+  const std::string plot =
+      fmt::format("/usr/bin/python3 {}/examples/posidonia_flume/plot.py {}", SPHFSI_SOURCE_DIR, o.out.string());
+  std::fflush(stdout);
+  if (std::system(plot.c_str()) != 0) fmt::print("(plot skipped: /usr/bin/python3 with matplotlib not available)\n");
+  const bool failed = (o.run_plants && !with.failure.empty()) || (o.run_empty && !without.failure.empty());
+  return failed ? 3 : 0;
+}
+
+int main(int argc, char** argv) try {
+  // `--no-plants` (no value) runs the empty flume only; the parser below takes `--name value` pairs
+  std::vector<char*> args{argv[0]};
+  bool no_plants = false;
+  for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) == "--no-plants") no_plants = true;
+    else args.push_back(argv[i]);
+  }
+  io::CommandLine cli(int(args.size()), args.data(),
+                      "posidonia_flume: Posidonia plants in the reference paper's wave flume (h = 0.2 m); wave "
+                      "height at the gauges with and without plants, tip trajectories. Flag --no-plants: run the "
+                      "empty flume only.");
+  Options o;
+  auto& s = o.scene;
+  s.wave_height = cli.get_number("height", 0.03, "target wave height H, m");
+  s.period = cli.get_number("period", 1.2, "wave period T, s");
+  s.ramp_periods = cli.get_number("ramp", 2, "paddle start-up ramp, periods");
+  s.particles_per_depth = cli.get_number("resolution", 20, "particles over the depth h/dp (40: dp = 5 mm)");
+  s.sound_speed_factor = cli.get_number("sound-speed", 7, "c0 / sqrt(g h)");
+  s.plants = int(cli.get_number("plants", 1, "number of plants"));
+  s.spacing = cli.get_number("spacing", 0.1, "distance between plants, m");
+  s.first_plant_x = cli.get_number("plant-x", 1.2, "centre line of the first plant, m");
+  s.height_ratio = cli.get_number("height-ratio", 0.4, "blade length / depth (paper: 0.32 to 0.5)");
+  const std::string blade = cli.get("blade", "equivalent", "blade model: equivalent | scaled (paper's Table 3)");
+  s.blade_rows = int(cli.get_number("blade-rows", 3, "particle rows across the blade"));
+  s.equivalent_bulk_modulus =
+      cli.get_number("bulk-modulus", 1e5, "bulk modulus of the equivalent blade, Pa (bending unaffected)");
+  s.poisson_ratio = cli.get_number("poisson", 0.3, "Poisson ratio of the real and scaled blade");
+  s.real_density = cli.get_number("real-density", 910, "density of the real blade, kg/m^3");
+  s.real_youngs_modulus = cli.get_number("real-modulus", 4.7e8, "Young's modulus of the real blade, Pa");
+  s.real_thickness = cli.get_number("real-thickness", 1e-4, "thickness of the real blade, m");
+  const std::string runs = cli.get("runs", "both", "runs: both | plants | empty");
+  o.alpha = cli.get_number("alpha", 0.01, "artificial viscosity alpha");
+  o.delta = cli.get_number("delta", 0.1, "delta-SPH coefficient");
+  o.waves_analysed = cli.get_number("waves", 4, "full-amplitude waves recorded at the last gauge");
+  o.end_time = cli.get_number("end-time", 0, "end time, s (0: from the waves to analyse at the last gauge)");
+  o.snapshots = cli.get_number("snapshots", 20, "VTK snapshots per run (0: none)");
+  const std::string precision = cli.get("precision", "float", "fluid scalar type: float | double");
+  o.out = cli.get("output", "out/posidonia_flume", "output folder");
+  o.empty_from = cli.get("empty-from", "", "with --runs plants: take the empty flume's heights from DIR/empty");
+  if (!cli.finish()) return 0;
+  if (blade == "equivalent") s.blade = scenes::BladeModel::equivalent;
+  else if (blade == "scaled") s.blade = scenes::BladeModel::scaled;
+  else throw InputError(fmt::format("--blade '{}': valid are equivalent, scaled", blade));
+  if (runs != "both" && runs != "plants" && runs != "empty")
+    throw InputError(fmt::format("--runs '{}': valid are both, plants, empty", runs));
+  o.run_plants = runs != "empty" && !no_plants && s.plants > 0;
+  o.run_empty = runs != "plants" || no_plants;
+  s.validate();
+  if (precision == "float") return run<float>(o);
+  if (precision == "double") return run<double>(o);
+  throw InputError(fmt::format("--precision '{}': valid are float, double", precision));
+} catch (const std::exception& e) {
+  fmt::print(stderr, "posidonia_flume: error: {}\n", e.what());
+  return 1;
+}

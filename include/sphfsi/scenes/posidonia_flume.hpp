@@ -1,0 +1,193 @@
+// sphfsi: the Posidonia flume of the reference paper (Results section, Figure 8): a 2D wave flume of still-water
+// depth 0.2 m with a piston paddle, one plant (or a meadow of N plants) clamped in the bed from x = 1.2 m on, and
+// gauges at x = 0.6, 1.0, 1.3 and 1.7 m; the damping zone of waves/damping_zone.hpp absorbs the waves beyond.
+//
+// A plant is a single full-width blade of `blade_rows` particle rows (thickness t_m = blade_rows dp), standing
+// from the bed z = 0 to the blade length l = height_ratio h, with `clamp_rows` more rows embedded below the bed:
+// the total-Lagrangian solid clamps them by reflection on the bed plane (solid/total_lagrangian.hpp), so the
+// blade's displacement vanishes at z = 0. All plants form ONE solid body (their reference neighbourhoods do not
+// overlap: spacing - t_m > kernel support), so one coupled model serves any number of plants.
+//
+// The real blade (Folkard 2005, the paper's Table 3): rho = 910 kg/m^3, E = 4.7e8 Pa, t = 0.1 mm; nu = 0.30
+// (from K = 3.92e8 Pa and E; Table 3's shear modulus 1.81e9 Pa is inconsistent with E and K, its "modified"
+// value 1.2e6 = 1.81e8 / 150 shows 1.81e8 was meant, which also gives nu = 0.30). It is 1/150 of a 15 mm model
+// blade, so the modelled blade's properties must be changed (BladeModel):
+//   scaled:     the paper's choice: moduli divided by the thickness ratio t_m / t, density unchanged:
+//               E_m = E t / t_m, rho_m = rho (t_m = 15 mm: E_m = 3.13e6 Pa, Table 3 "modified"). This keeps the
+//               extensional stiffness E t per unit width and multiplies the bending stiffness E t^3 / 12 by
+//               (t_m / t)^2 (150^2 at 15 mm) and the mass per unit length by t_m / t.
+//   equivalent: E_m = E (t / t_m)^3, rho_m = rho t / t_m: bending stiffness per unit width and mass per unit
+//               length of the real blade. At t_m = 15 mm E_m = 139 Pa and rho_m = 6.1 kg/m^3: the blade is
+//               very light, and its Young's modulus is far below the hydrostatic pressure (about 2000 Pa at the
+//               bed), so a Poisson ratio of 0.3 would let the water crush the blade; the equivalent blade therefore
+//               takes its bulk modulus from `equivalent_bulk_modulus` (near incompressible), which changes
+//               neither its bending stiffness (E) nor its mass.
+// In 2D both are plane strain: the bending stiffness per unit width is E_m t_m^3 / (12 (1 - nu_m^2)).
+#pragma once
+
+#include <sphfsi/core/error.hpp>
+#include <sphfsi/core/particle_system.hpp>
+#include <sphfsi/scenes/builders.hpp>
+#include <sphfsi/scenes/wave_flume.hpp>
+#include <sphfsi/solid/elastic_material.hpp>
+
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+namespace sphfsi::scenes {
+
+enum class BladeModel { equivalent, scaled };
+
+/// The Posidonia flume: waves, resolution, plants and blade model (lengths in m).
+template <Real T>
+struct PosidoniaFlume {
+  // waves (the paper gives none: regular waves typical of its flume)
+  T depth{T(0.2)};            ///< still-water depth h, m
+  T wave_height{T(0.03)};     ///< target H, m
+  T period{T(1.2)};           ///< T, s
+  T ramp_periods{T(2)};       ///< paddle start-up ramp, periods
+  T particles_per_depth{T(20)};  ///< h / dp (20: dp = 10 mm; the paper's dp = 5 mm is 40)
+  T sound_speed_factor{T(7)};    ///< c0 / sqrt(g h)
+  T absorber_start{T(2)};        ///< entrance of the damping zone, m (beyond the last gauge)
+  T damping_wavelengths{T(1)};   ///< damping zone length, wavelengths
+  T damping_rate{T(10)};         ///< beta, 1/s
+  std::vector<T> gauges{T(0.6), T(1.0), T(1.3), T(1.7)};  ///< gauge positions, m
+  // plants
+  int plants{1};              ///< number of plants (0: the empty flume)
+  T first_plant_x{T(1.2)};    ///< centre line of the first (upstream) plant, m
+  T spacing{T(0.1)};          ///< distance between neighbouring plants, m
+  T height_ratio{T(0.4)};     ///< blade length / depth, [0.1, 0.9] (paper: 0.32 to 0.5)
+  BladeModel blade{BladeModel::equivalent};
+  int blade_rows{3};          ///< particle rows across the blade (>= 3: the normal needs them)
+  int clamp_rows{3};          ///< rows embedded below the bed (the reflection clamp's images)
+  // the real blade (Table 3)
+  T real_density{T(910)};          ///< kg/m^3
+  T real_youngs_modulus{T(4.7e8)};  ///< Pa
+  T real_thickness{T(1e-4)};       ///< m
+  T poisson_ratio{T(0.3)};         ///< nu from K and E of Table 3 (scaled blade and real blade)
+  T equivalent_bulk_modulus{T(1e5)};  ///< least K of the equivalent blade, Pa (50x the bed pressure rho g h)
+
+  void validate() const {
+    require_positive("PosidoniaFlume::depth (m)", depth);
+    require_in_range("PosidoniaFlume::particles_per_depth (h/dp)", particles_per_depth, T(4), T(400));
+    require_in_range("PosidoniaFlume::plants", plants, 0, 200);
+    require_in_range("PosidoniaFlume::height_ratio (blade length / depth)", height_ratio, T(0.1), T(0.9));
+    require_in_range("PosidoniaFlume::blade_rows", blade_rows, 3, 20);
+    require_in_range("PosidoniaFlume::clamp_rows", clamp_rows, 2, 8);
+    require_positive("PosidoniaFlume::real_density (kg/m^3)", real_density);
+    require_positive("PosidoniaFlume::real_youngs_modulus (Pa)", real_youngs_modulus);
+    require_positive("PosidoniaFlume::real_thickness (m)", real_thickness);
+    require_in_open_range("PosidoniaFlume::poisson_ratio", poisson_ratio, T(-1), T(0.5));
+    require_positive("PosidoniaFlume::equivalent_bulk_modulus (Pa)", equivalent_bulk_modulus);
+    if (!gauges.empty())
+      for (T x : gauges) require_in_range("PosidoniaFlume gauge position (m)", x, T(0), absorber_start);
+    if (plants > 0) {
+      require_in_range("PosidoniaFlume::first_plant_x (m)", first_plant_x, T(4) * dp(), absorber_start);
+      const T last = first_plant_x + T(plants - 1) * spacing;
+      if (plants > 1)
+        require_in_range("PosidoniaFlume::spacing (m, plants' reference supports must not overlap)", spacing,
+                         blade_thickness() + T(3) * dp(), T(10) * depth);
+      require_in_range("PosidoniaFlume last plant x (m)", last, first_plant_x, absorber_start);
+    }
+  }
+
+  T dp() const { return depth / particles_per_depth; }
+  T blade_thickness() const { return T(blade_rows) * dp(); }  ///< t_m, m
+  int blade_length_rows() const { return std::max(1, int(std::lround(height_ratio * depth / dp()))); }
+  T blade_length() const { return T(blade_length_rows()) * dp(); }  ///< l (rounded to whole rows), m
+  /// Centre line of each plant, snapped to the fluid lattice ((i + 1/2) dp) shifted by dp/2 for even row counts.
+  std::vector<T> plant_x() const {
+    std::vector<T> x;
+    const T d = dp(), shift = blade_rows % 2 == 0 ? T(0.5) * d : T(0);
+    for (int i = 0; i < plants; ++i) {
+      const T want = first_plant_x + T(i) * spacing;
+      x.push_back((std::floor((want - shift) / d) + T(0.5)) * d + shift);
+    }
+    return x;
+  }
+
+  /// The real blade's material (plane strain in 2D would need E' = E / (1 - nu^2)).
+  ElasticMaterial<T> real_material() const { return {real_density, real_youngs_modulus, poisson_ratio}; }
+  /// The modelled blade's material at thickness t_m (see the header comment).
+  ElasticMaterial<T> blade_material() const {
+    const T ratio = real_thickness / blade_thickness();  // t / t_m
+    if (blade == BladeModel::scaled) return {real_density, real_youngs_modulus * ratio, poisson_ratio};
+    const T E = real_youngs_modulus * ratio * ratio * ratio;
+    // nu from E and K: K = E / (3 (1 - 2 nu))
+    // bulk modulus raised to at least equivalent_bulk_modulus: nu from K = E / (3 (1 - 2 nu))
+    return {real_density * ratio, E, std::max(poisson_ratio, T(0.5) - E / (T(6) * equivalent_bulk_modulus))};
+  }
+  /// Bending stiffness per unit width of the model blade in plane strain, E_m t_m^3 / (12 (1 - nu_m^2)), N m.
+  T model_bending_stiffness() const {
+    const auto m = blade_material();
+    const T t = blade_thickness();
+    return m.plane_strain_modulus() * t * t * t / T(12);
+  }
+  /// Bending stiffness per unit width of the real blade, E t^3 / 12, N m.
+  T real_bending_stiffness() const {
+    return real_youngs_modulus * real_thickness * real_thickness * real_thickness / T(12);
+  }
+
+  /// The flume: piston, damping zone from absorber_start over damping_wavelengths, fluid left out of the plants.
+  WaveFlumeGeometry<T> flume() const {
+    WaveFlumeGeometry<T> g;
+    g.wave.paddle = waves::PaddleType::piston;
+    g.wave.wave_height = wave_height;
+    g.wave.period = period;
+    g.wave.depth = depth;
+    g.wave.ramp_periods = ramp_periods;
+    g.particles_per_depth = particles_per_depth;
+    g.sound_speed_factor = sound_speed_factor;
+    const T L = g.wavelength();
+    g.length_wavelengths = absorber_start / L + damping_wavelengths;
+    g.damping_wavelengths = damping_wavelengths;
+    g.damping_rate = damping_rate;
+    g.absorber = FlumeAbsorber::damping_zone;
+    const T half = T(0.5) * blade_thickness(), top = blade_length();
+    for (T x : plant_x()) g.fluid_exclusions.push_back({Vec<2, T>(x - half, T(0)), Vec<2, T>(x + half, top)});
+    return g;
+  }
+};
+
+/// What build_posidonia_flume made.
+template <Real T>
+struct PosidoniaLayout {
+  WaveFlumeLayout<T> flume;
+  std::int32_t plant_body{WaveFlumeLayout<T>::first_free_body};
+  std::vector<T> plant_x;                         ///< centre lines, m
+  std::vector<std::vector<std::uint32_t>> tips;   ///< ids of each plant's top row
+  std::size_t solid_particles{0};                 ///< including the embedded rows
+};
+
+/// Fills `system` (empty, on wave_flume_domain(scene.flume())) with the flume and the plants (solid body
+/// plant_body). The caller creates the solid model and clamps it with clamp_by_reflection(0, +z) on the bed.
+template <class System>
+PosidoniaLayout<typename System::scalar_type> build_posidonia_flume(
+    System& system, const PosidoniaFlume<typename System::scalar_type>& scene) {
+  using T = typename System::scalar_type;
+  using V = Vec<2, T>;
+  scene.validate();
+  const WaveFlumeGeometry<T> g = scene.flume();
+  PosidoniaLayout<T> out;
+  out.flume = build_wave_flume(system, g);
+  out.plant_x = scene.plant_x();
+  const T dp = scene.dp(), half = T(0.5) * scene.blade_thickness(), top = scene.blade_length();
+  const Resolution<T> res{dp, g.smoothing_ratio};
+  const auto material = scene.blade_material();
+  const T mass = material.density * dp * dp;
+  for (T xc : out.plant_x) {
+    std::vector<std::uint32_t> tip;
+    // the blade (z in (0, l)) and its embedded image rows (z in (-clamp_rows dp, 0)), one lattice
+    for_each_lattice_point<2, T>(V(xc - half, -T(scene.clamp_rows) * dp), V(xc + half, top), dp, [&](const V& x) {
+      const std::size_t slot =
+          system.particles().add(Kind::solid, x, V::Zero(), material.density, mass, res.h(), out.plant_body);
+      if (x[1] > top - dp) tip.push_back(system.particles().id[slot]);
+      ++out.solid_particles;
+    });
+    out.tips.push_back(std::move(tip));
+  }
+  return out;
+}
+
+}  // namespace sphfsi::scenes
