@@ -348,7 +348,8 @@ int main(int argc, char** argv) try {
   s.spacing = cli.get_number("spacing", 0.1, "distance between plants, m");
   s.first_plant_x = cli.get_number("plant-x", 1.2, "centre line of the first plant, m");
   s.height_ratio = cli.get_number("height-ratio", 0.4, "blade length / depth (paper: 0.32 to 0.5)");
-  const std::string blade = cli.get("blade", "equivalent", "blade model: equivalent | scaled (paper's Table 3)");
+  const std::string blade =
+      cli.get("blade", "scaled", "blade model: scaled (paper Table 3) | equivalent (blows up: docs/posidonia.md)");
   s.blade_rows = int(cli.get_number("blade-rows", 3, "particle rows across the blade"));
   s.equivalent_bulk_modulus =
       cli.get_number("bulk-modulus", 1e5, "bulk modulus of the equivalent blade, Pa (bending unaffected)");
