@@ -31,7 +31,12 @@ target_compile_definitions(sphfsi_unit_tests_sanitized PRIVATE
   SPHFSI_TEST_OUTPUT_DIR="${CMAKE_CURRENT_BINARY_DIR}/output_sanitized")
 unset(_sphfsi_sanitize)
 
-add_test(NAME sanitizer.unit_tests COMMAND sphfsi_unit_tests_sanitized)
+# One long physics run is left out: the undamped oscillating-plate energy test (5 periods of a TLSPH plate) takes
+# 73 s under ASan + UBSan at -O1 (Eigen's small fixed-size expressions are no longer inlined, every index is
+# checked), more than a quarter of this test; the same solid loop runs here in the rigid-rotation, sub-cycling,
+# clamp and momentum cases of test_solids.cpp.
+set(SPHFSI_SANITIZER_EXCLUDED_CASES "~TLSPH: energy of the undamped oscillating plate*")
+add_test(NAME sanitizer.unit_tests COMMAND sphfsi_unit_tests_sanitized ${SPHFSI_SANITIZER_EXCLUDED_CASES})
 set_tests_properties(sanitizer.unit_tests PROPERTIES
   LABELS sanitizer
   TIMEOUT 600
