@@ -63,8 +63,7 @@ int run(const Options& opt, const Coupling& coupling) {
   const Scalar clamp_y = scene.clamp_height();
   if constexpr (requires { solid.clamp_by_reflection(Vec<2, Scalar>(), Vec<2, Scalar>()); })
     solid.clamp_by_reflection(Vec<2, Scalar>(0, clamp_y), Vec<2, Scalar>(0, -1));
-  else
-    solid.clamp_where([&](const Vec<2, Scalar>& X) { return X[1] > clamp_y; });
+  else solid.clamp_where([&](const Vec<2, Scalar>& X) { return X[1] > clamp_y; });
   using Gate = CoupledBody<Coupling, Solid>;
   Simulation<System, SymplecticVerlet, Gate> sim(system, scene.fluid(), {}, Gate(coupling, std::move(solid)));
 

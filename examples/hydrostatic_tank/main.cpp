@@ -39,16 +39,18 @@ int main(int argc, char** argv) try {
   System system = make_tank(cfg);
   TankSimulation sim(system, fluid_parameters(cfg));
   const Vector probe(0.5 * cfg.width, 0.5 * cfg.depth);
-  fmt::print("hydrostatic tank: {} walls, H = {} m, L = {} m, dp = {:.4g} m, {} fluid + {} wall particles, "
-             "c0 = {:.3g} m/s, acoustic period 4H/c0 = {:.3g} s\n",
-             walls, cfg.depth, cfg.width, cfg.dp(), system.particles().count(Kind::fluid),
-             system.particles().count(Kind::wall), cfg.sound_speed(), cfg.acoustic_period());
+  fmt::print(
+      "hydrostatic tank: {} walls, H = {} m, L = {} m, dp = {:.4g} m, {} fluid + {} wall particles, "
+      "c0 = {:.3g} m/s, acoustic period 4H/c0 = {:.3g} s\n",
+      walls, cfg.depth, cfg.width, cfg.dp(), system.particles().count(Kind::fluid),
+      system.particles().count(Kind::wall), cfg.sound_speed(), cfg.acoustic_period());
 
-  io::CsvWriter probe_csv(output / "probe.csv",
-                          {"t", "p_probe", "p_theory", "relative_error", "surface", "max_speed", "kinetic_energy",
-                           "particles_lost"},
-                          fmt::format("hydrostatic tank, {} walls, probe at x = {} m, z = {} m; p_theory = rho0 g "
-                                      "(surface - z), surface = SPH volume / width", walls, probe[0], probe[1]));
+  io::CsvWriter probe_csv(
+      output / "probe.csv",
+      {"t", "p_probe", "p_theory", "relative_error", "surface", "max_speed", "kinetic_energy", "particles_lost"},
+      fmt::format("hydrostatic tank, {} walls, probe at x = {} m, z = {} m; p_theory = rho0 g "
+                  "(surface - z), surface = SPH volume / width",
+                  walls, probe[0], probe[1]));
   const double interval = 0.01;  // s between probe samples
   double next_sample = 0;
   auto sample = [&](TankSimulation& s) {
@@ -67,22 +69,24 @@ int main(int argc, char** argv) try {
 
   // Final state: pressure profile on the tank's centre line and the checks.
   const double surface = free_surface_height(system, cfg);
-  io::CsvWriter profile_csv(output / "profile.csv", {"z", "p_sph", "p_theory"},
-                            fmt::format("pressure at x = {} m, t = {} s; surface H_s = {} m", probe[0], sim.time(),
-                                        surface));
+  io::CsvWriter profile_csv(
+      output / "profile.csv", {"z", "p_sph", "p_theory"},
+      fmt::format("pressure at x = {} m, t = {} s; surface H_s = {} m", probe[0], sim.time(), surface));
   for (double z = 0.5 * cfg.dp(); z < surface; z += 0.5 * cfg.dp())
     profile_csv.write_row({z, shepard_pressure(system, Vector(probe[0], z)), hydrostatic_pressure(cfg, surface, z)});
   const double p_sph = shepard_pressure(system, probe);
-  const double error = (p_sph - hydrostatic_pressure(cfg, surface, probe[1])) / hydrostatic_pressure(cfg, surface, probe[1]);
-  const double error_initial_h = (p_sph - hydrostatic_pressure(cfg, cfg.depth, probe[1])) /
-                                 hydrostatic_pressure(cfg, cfg.depth, probe[1]);
+  const double error =
+      (p_sph - hydrostatic_pressure(cfg, surface, probe[1])) / hydrostatic_pressure(cfg, surface, probe[1]);
+  const double error_initial_h =
+      (p_sph - hydrostatic_pressure(cfg, cfg.depth, probe[1])) / hydrostatic_pressure(cfg, cfg.depth, probe[1]);
   const std::size_t lost = particles_outside(system, cfg);
   fmt::print("t = {:.3f} s after {} steps ({:.1f} acoustic periods)\n", sim.time(), sim.step_count(),
              sim.time() / cfg.acoustic_period());
   fmt::print("settled surface H_s = {:.5f} m (initial H = {} m)\n", surface, cfg.depth);
-  fmt::print("mid-depth pressure: SPH {:.2f} Pa, rho0 g (H_s - z) = {:.2f} Pa, error {:+.3f} % "
-             "(vs initial H: {:+.3f} %)\n",
-             p_sph, hydrostatic_pressure(cfg, surface, probe[1]), 100 * error, 100 * error_initial_h);
+  fmt::print(
+      "mid-depth pressure: SPH {:.2f} Pa, rho0 g (H_s - z) = {:.2f} Pa, error {:+.3f} % "
+      "(vs initial H: {:+.3f} %)\n",
+      p_sph, hydrostatic_pressure(cfg, surface, probe[1]), 100 * error, 100 * error_initial_h);
   fmt::print("max fluid speed {:.3e} m/s, kinetic energy {:.3e} J/m, particles lost {}\n", max_fluid_speed(system),
              fluid_kinetic_energy(system), lost);
   fmt::print("lowest fluid particle above the bed: {:.3f} dp\n", lowest_fluid_height(system, cfg) / cfg.dp());
@@ -90,8 +94,8 @@ int main(int argc, char** argv) try {
              double(system.size()) * double(sim.step_count()) / wall_time);
 
   if (std::filesystem::exists("/usr/bin/python3")) {
-    const std::string cmd = fmt::format("/usr/bin/python3 '{}/examples/hydrostatic_tank/plot.py' '{}'",
-                                        SPHFSI_SOURCE_DIR, output.string());
+    const std::string cmd =
+        fmt::format("/usr/bin/python3 '{}/examples/hydrostatic_tank/plot.py' '{}'", SPHFSI_SOURCE_DIR, output.string());
     if (std::system(cmd.c_str()) != 0) fmt::print("(plot skipped: plot.py failed)\n");
   }
   const bool pass = std::abs(error) <= 0.02 && lost == 0;

@@ -39,20 +39,20 @@ using System = sphfsi::ParticleSystem<2, T, sphfsi::WendlandC2<2>, sphfsi::Linea
 
 struct Options {
   std::string model = "tl";
-  int resolution = 6;            // particles across the thickness H
-  T vf = 0.01;                   // amplitude factor V_f
-  T periods = 3;                 // simulated time in Euler-Bernoulli periods
-  bool sag = false;              // static cantilever under gravity instead of the free oscillation
-  T youngs = -1;                 // E, Pa (default 2e6 for the plate, 2e7 for the sag)
-  T damping = -1;                // c_d, 1/s (default 0 for the plate, the first-mode omega for the sag)
-  T end_time = -1;               // s (sag)
-  T hourglass = 0.1;             // TLSPH alpha_hg
-  T h_ratio = 1.3;               // h / dp
-  T cfl = 0.3;                   // solid CFL number
+  int resolution = 6;              // particles across the thickness H
+  T vf = 0.01;                     // amplitude factor V_f
+  T periods = 3;                   // simulated time in Euler-Bernoulli periods
+  bool sag = false;                // static cantilever under gravity instead of the free oscillation
+  T youngs = -1;                   // E, Pa (default 2e6 for the plate, 2e7 for the sag)
+  T damping = -1;                  // c_d, 1/s (default 0 for the plate, the first-mode omega for the sag)
+  T end_time = -1;                 // s (sag)
+  T hourglass = 0.1;               // TLSPH alpha_hg
+  T h_ratio = 1.3;                 // h / dp
+  T cfl = 0.3;                     // solid CFL number
   bool fixed_clamp = false;        // TLSPH: hold the wall part at rest instead of the reflected clamp
   bool linear_correction = false;  // TLSPH: Bonet-Lok gradient (exact for linear fields only) everywhere
-  bool uncorrected = false;      // ULSPH: original GMS 2001 velocity gradient (no kernel-gradient correction)
-  T viscosity = -1;              // artificial viscosity alpha (default 0 TL, 0.5 UL)
+  bool uncorrected = false;        // ULSPH: original GMS 2001 velocity gradient (no kernel-gradient correction)
+  T viscosity = -1;                // artificial viscosity alpha (default 0 TL, 0.5 UL)
   std::string output = "oscillating_plate.csv";
 };
 
@@ -161,8 +161,8 @@ int run(const Options& o) {
     const T x = p.position[i].x();
     if (x > x_tip - 0.5 * dp) tip.push_back(p.id[i]);
     if (o.sag || x < 0) continue;
-    p.velocity[i].y() = o.vf * c0 *
-                        (M * (std::cos(k * x) - std::cosh(k * x)) - N * (std::sin(k * x) - std::sinh(k * x))) / Q;
+    p.velocity[i].y() =
+        o.vf * c0 * (M * (std::cos(k * x) - std::cosh(k * x)) - N * (std::sin(k * x) - std::sinh(k * x))) / Q;
   }
   auto tip_deflection = [&]() {
     T y = 0;
@@ -196,24 +196,25 @@ int run(const Options& o) {
     stretch_max = std::max(stretch_max, stretch);
     t_series.push_back(s.time());
     w_series.push_back(w);
-    csv.print("{:.6e},{:.6e},{:.6e},{:.6e},{:.6f}\n", s.time(), w, model.kinetic_energy(), internal_energy(),
-              stretch);
+    csv.print("{:.6e},{:.6e},{:.6e},{:.6e},{:.6f}\n", s.time(), w, model.kinetic_energy(), internal_energy(), stretch);
   });
   const T seconds = std::chrono::duration<T>(std::chrono::steady_clock::now() - start).count();
   csv.close();
 
-  fmt::print("model {} | H/dp = {} | dp = {:.4g} m | particles {} ({} clamped) | solid dt = {:.3g} s | "
-             "sub-steps {} | wall time {:.2f} s\n",
-             o.model, o.resolution, dp, p.size(), clamped, model.solid_time_step(), model.sub_step_total(), seconds);
+  fmt::print(
+      "model {} | H/dp = {} | dp = {:.4g} m | particles {} ({} clamped) | solid dt = {:.3g} s | "
+      "sub-steps {} | wall time {:.2f} s\n",
+      o.model, o.resolution, dp, p.size(), clamped, model.solid_time_step(), model.sub_step_total(), seconds);
   if (o.sag) {
     const T q = rho * 9.81 * H, I = H * H * H / 12, Ep = material.plane_strain_modulus();
     const T xt = x_tip;
     const T w_theory = q * xt * xt * (6 * L * L - 4 * L * xt + xt * xt) / (24 * Ep * I);
     const T w = -w_series.back();
-    fmt::print("sag: E = {:.3g} Pa, c_d = {:.3g} 1/s, t_end = {:.3g} s: tip deflection {:.5e} m, beam theory "
-               "(x = {:.4g} m) {:.5e} m, error {:+.2f} %, last-sample tip speed {:.2e} m/s\n",
-               o.youngs, params.damping, end_time, w, xt, w_theory, 100 * (w - w_theory) / w_theory,
-               std::abs(w_series.back() - w_series[w_series.size() - 2]) / sample);
+    fmt::print(
+        "sag: E = {:.3g} Pa, c_d = {:.3g} 1/s, t_end = {:.3g} s: tip deflection {:.5e} m, beam theory "
+        "(x = {:.4g} m) {:.5e} m, error {:+.2f} %, last-sample tip speed {:.2e} m/s\n",
+        o.youngs, params.damping, end_time, w, xt, w_theory, 100 * (w - w_theory) / w_theory,
+        std::abs(w_series.back() - w_series[w_series.size() - 2]) / sample);
     return 0;
   }
   // Zero crossings in both directions after the start (linear interpolation) -> half periods; positive
@@ -221,8 +222,8 @@ int run(const Options& o) {
   std::vector<T> crossings, peaks;
   for (std::size_t i = 2; i < w_series.size(); ++i) {
     if ((w_series[i - 1] < 0) != (w_series[i] < 0))
-      crossings.push_back(t_series[i - 1] + (t_series[i] - t_series[i - 1]) * (-w_series[i - 1]) /
-                                                (w_series[i] - w_series[i - 1]));
+      crossings.push_back(t_series[i - 1] +
+                          (t_series[i] - t_series[i - 1]) * (-w_series[i - 1]) / (w_series[i] - w_series[i - 1]));
     if (i + 1 < w_series.size() && w_series[i] > 0 && w_series[i] >= w_series[i - 1] && w_series[i] > w_series[i + 1])
       peaks.push_back(w_series[i]);
   }
@@ -234,10 +235,11 @@ int run(const Options& o) {
   const std::size_t half_periods = crossings.size() - 1;
   T decay = 0;
   if (peaks.size() >= 2) decay = 1 - std::pow(peaks.back() / peaks.front(), 1 / T(peaks.size() - 1));
-  fmt::print("V_f = {} | period {:.5f} s (from {} half periods) | Euler-Bernoulli {:.5f} s | error {:+.2f} % | "
-             "first amplitude {:.4e} m | decay per period {:.2f} % | max stretch {:.4f}\n",
-             o.vf, measured, half_periods, period, 100 * (measured - period) / period,
-             peaks.empty() ? 0.0 : peaks.front(), 100 * decay, stretch_max);
+  fmt::print(
+      "V_f = {} | period {:.5f} s (from {} half periods) | Euler-Bernoulli {:.5f} s | error {:+.2f} % | "
+      "first amplitude {:.4e} m | decay per period {:.2f} % | max stretch {:.4f}\n",
+      o.vf, measured, half_periods, period, 100 * (measured - period) / period, peaks.empty() ? 0.0 : peaks.front(),
+      100 * decay, stretch_max);
   return 0;
 }
 

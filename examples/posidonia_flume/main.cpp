@@ -218,8 +218,8 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
   }
   // tip excursion: half the peak-to-peak displacement once the full waves have reached the plant
   for (std::size_t k = 0; k < layout.tips.size(); ++k) {
-    const double from = double(maker.ramp_time()) + double(layout.plant_x[k]) / double(wave.group_velocity) +
-                        double(wave.period);
+    const double from =
+        double(maker.ramp_time()) + double(layout.plant_x[k]) / double(wave.group_velocity) + double(wave.period);
     double lo_x = 1e9, hi_x = -1e9, lo_z = 1e9, hi_z = -1e9, sum_x = 0, sum_z = 0;
     std::size_t n = 0;
     for (std::size_t j = 0; j < times.size(); ++j) {
@@ -249,22 +249,24 @@ int run(const Options& o) {
       "piston stroke S = {:.4f} m\n",
       sizeof(T) == 4 ? "float" : "double", double(scene.depth), double(scene.period), double(scene.wave_height),
       double(w.kh()), double(w.wavelength), double(w.group_velocity), double(maker.stroke()));
-  fmt::print("resolution: dp = {:.4f} m (h/dp = {}, H/dp = {:.2f}, L/dp = {:.0f}); flume {:.2f} m, damping zone "
-             "{:.2f} ... {:.2f} m; c0 = {:.2f} m/s\n",
-             double(scene.dp()), double(scene.particles_per_depth), double(scene.wave_height / scene.dp()),
-             double(w.wavelength / scene.dp()), double(g.length()), double(g.damping_zone().x_start),
-             double(g.damping_zone().x_end), double(g.sound_speed()));
-  fmt::print("plants: {} at x = {} m, blade {} model: length l = {:.3f} m ({} rows, l/h = {:.3f}), thickness t_m = "
-             "{:.4f} m ({} rows);\n  rho_m = {:.4g} kg/m^3, E_m = {:.4g} Pa, nu_m = {:.5g} (K_m = {:.4g} Pa), "
-             "P-wave speed {:.3g} m/s; bending stiffness per width {:.3g} N m (real E t^3/12 = {:.3g} N m, "
-             "ratio {:.4g}); mass per length {:.4g} kg/m^2 (real {:.4g})\n",
-             scene.plants, fmt::join(scene.plant_x(), ", "), scene.blade == scenes::BladeModel::scaled ? "scaled" :
-             "equivalent", double(scene.blade_length()), scene.blade_length_rows(),
-             double(scene.blade_length() / scene.depth), double(scene.blade_thickness()), scene.blade_rows,
-             double(m.density), double(m.youngs_modulus), double(m.poisson_ratio), double(m.bulk_modulus()),
-             double(m.p_wave_speed()), double(scene.model_bending_stiffness()), double(scene.real_bending_stiffness()),
-             double(scene.model_bending_stiffness() / scene.real_bending_stiffness()),
-             double(m.density * scene.blade_thickness()), double(scene.real_density * scene.real_thickness));
+  fmt::print(
+      "resolution: dp = {:.4f} m (h/dp = {}, H/dp = {:.2f}, L/dp = {:.0f}); flume {:.2f} m, damping zone "
+      "{:.2f} ... {:.2f} m; c0 = {:.2f} m/s\n",
+      double(scene.dp()), double(scene.particles_per_depth), double(scene.wave_height / scene.dp()),
+      double(w.wavelength / scene.dp()), double(g.length()), double(g.damping_zone().x_start),
+      double(g.damping_zone().x_end), double(g.sound_speed()));
+  fmt::print(
+      "plants: {} at x = {} m, blade {} model: length l = {:.3f} m ({} rows, l/h = {:.3f}), thickness t_m = "
+      "{:.4f} m ({} rows);\n  rho_m = {:.4g} kg/m^3, E_m = {:.4g} Pa, nu_m = {:.5g} (K_m = {:.4g} Pa), "
+      "P-wave speed {:.3g} m/s; bending stiffness per width {:.3g} N m (real E t^3/12 = {:.3g} N m, "
+      "ratio {:.4g}); mass per length {:.4g} kg/m^2 (real {:.4g})\n",
+      scene.plants, fmt::join(scene.plant_x(), ", "),
+      scene.blade == scenes::BladeModel::scaled ? "scaled" : "equivalent", double(scene.blade_length()),
+      scene.blade_length_rows(), double(scene.blade_length() / scene.depth), double(scene.blade_thickness()),
+      scene.blade_rows, double(m.density), double(m.youngs_modulus), double(m.poisson_ratio), double(m.bulk_modulus()),
+      double(m.p_wave_speed()), double(scene.model_bending_stiffness()), double(scene.real_bending_stiffness()),
+      double(scene.model_bending_stiffness() / scene.real_bending_stiffness()),
+      double(m.density * scene.blade_thickness()), double(scene.real_density * scene.real_thickness));
 
   CaseResult with, without;
   if (o.run_plants) with = run_case<T, true>(o, o.out / "plants");
@@ -299,17 +301,17 @@ int run(const Options& o) {
       fmt::print("  plant {} at x = {:.3f} m: |dx| {:.2f} mm, |dz| {:.2f} mm; mean dx {:+.2f} mm, dz {:+.2f} mm\n", k,
                  double(scene.plant_x()[k]), 1e3 * with.tip_dx_amplitude[k], 1e3 * with.tip_dz_amplitude[k],
                  1e3 * with.tip_dx_mean[k], 1e3 * with.tip_dz_mean[k]);
-    fmt::print("plants run: {} + {} + {} particles, {} steps, {} solid sub-steps, {:.1f} s wall; max stretch {:.3f}, "
-               "fluid particles inside the blades (max) {}{}\n",
-               with.fluid, with.wall, with.solid, with.steps, with.solid_sub_steps, with.wall_seconds,
-               with.max_stretch, with.fluid_inside_max, with.failure.empty() ? "" : "; FAILED: " + with.failure);
+    fmt::print(
+        "plants run: {} + {} + {} particles, {} steps, {} solid sub-steps, {:.1f} s wall; max stretch {:.3f}, "
+        "fluid particles inside the blades (max) {}{}\n",
+        with.fluid, with.wall, with.solid, with.steps, with.solid_sub_steps, with.wall_seconds, with.max_stretch,
+        with.fluid_inside_max, with.failure.empty() ? "" : "; FAILED: " + with.failure);
   }
   if (o.run_empty)
     fmt::print("empty run: {} + {} particles, {} steps, {:.1f} s wall{}\n", without.fluid, without.wall, without.steps,
                without.wall_seconds, without.failure.empty() ? "" : "; FAILED: " + without.failure);
-  io::CsvWriter summary(o.out / "summary.csv",
-                        {"run", "fluid", "wall", "solid", "steps", "solid_sub_steps", "wall_s", "reached_s",
-                         "max_stretch", "fluid_inside_max", "failed"});
+  io::CsvWriter summary(o.out / "summary.csv", {"run", "fluid", "wall", "solid", "steps", "solid_sub_steps", "wall_s",
+                                                "reached_s", "max_stretch", "fluid_inside_max", "failed"});
   if (o.run_plants)
     summary.write_row({1, double(with.fluid), double(with.wall), double(with.solid), double(with.steps),
                        double(with.solid_sub_steps), with.wall_seconds, with.reached, with.max_stretch,

@@ -39,8 +39,8 @@ TEST_CASE("posidonia blade models: the paper's Table 3 and the preserved quantit
     const auto e = s.blade_material();
     const double t = s.blade_thickness();
     CHECK_THAT(e.youngs_modulus * t * t * t, WithinRel(4.7e8 * 1e-12, 1e-9));  // E t^3 / 12 preserved
-    CHECK_THAT(e.density * t, WithinRel(910 * 1e-4, 1e-12));                  // mass per length preserved
-    CHECK(e.bulk_modulus() >= 0.999 * s.equivalent_bulk_modulus);             // not crushed by the water
+    CHECK_THAT(e.density * t, WithinRel(910 * 1e-4, 1e-12));                   // mass per length preserved
+    CHECK(e.bulk_modulus() >= 0.999 * s.equivalent_bulk_modulus);              // not crushed by the water
     CHECK(e.poisson_ratio < 0.5);
   }
 }

@@ -103,12 +103,12 @@ inline Vec<Dim, T> repulsive_force(const Vec<Dim, T>& dx, const Vec<Dim, T>& dv,
   if (q <= T(0) || q >= T(1)) return Vec<Dim, T>::Zero();
   const T xi = (dx - d_perp * n).norm();
   if (xi >= params.boundary_spacing) return Vec<Dim, T>::Zero();
-  const T A = params.strength * c0 * c0 / h;                                                    // (19)
+  const T A = params.strength * c0 * c0 / h;                                                     // (19)
   const T R = A * (T(1) - q) / std::sqrt(q);                                                     // (18)
   const T P = T(0.5) * (T(1) + std::cos(std::numbers::pi_v<T> * xi / params.boundary_spacing));  // (20)
-  const T eps = repulsive_depth_factor(elevation, params.local_depth) +
-                repulsive_velocity_factor(dv.dot(n), c0);                                       // (21)
-  return n * (R * P * eps);                                                                     // (17)
+  const T eps =
+      repulsive_depth_factor(elevation, params.local_depth) + repulsive_velocity_factor(dv.dot(n), c0);  // (21)
+  return n * (R * P * eps);                                                                              // (17)
 }
 
 }  // namespace sphfsi

@@ -19,10 +19,10 @@ namespace sphfsi {
 template <Real T>
 struct RepulsiveForce {
   static constexpr const char* name = "repulsive-force";
-  T water_level{0};   ///< still-water level z0 for eps(z), m
-  T local_depth{0};   ///< h0 of eq. 22; <= 0: eps(z) = 1 (no depth scaling), m
-  T sound_speed{0};   ///< c0 used in A = 0.01 c0^2 / h (19) and eps(u) (23); 0: the fluid EOS's c0, m/s
-  T range_factor{1};  ///< scales the boundary spacing db used in P(xi) (eq. 20), [0.5, 3]
+  T water_level{0};     ///< still-water level z0 for eps(z), m
+  T local_depth{0};     ///< h0 of eq. 22; <= 0: eps(z) = 1 (no depth scaling), m
+  T sound_speed{0};     ///< c0 used in A = 0.01 c0^2 / h (19) and eps(u) (23); 0: the fluid EOS's c0, m/s
+  T range_factor{1};    ///< scales the boundary spacing db used in P(xi) (eq. 20), [0.5, 3]
   T strength{T(0.01)};  ///< k of A = k c0^2 / h (eq. 19: 0.01); see repulsive_strength_for_rest_gap(), > 0
 
   void validate() const {

@@ -45,29 +45,29 @@ enum class BladeModel { equivalent, scaled };
 template <Real T>
 struct PosidoniaFlume {
   // waves (the paper gives none: regular waves typical of its flume)
-  T depth{T(0.2)};            ///< still-water depth h, m
-  T wave_height{T(0.03)};     ///< target H, m
-  T period{T(1.2)};           ///< T, s
-  T ramp_periods{T(2)};       ///< paddle start-up ramp, periods
-  T particles_per_depth{T(20)};  ///< h / dp (20: dp = 10 mm; the paper's dp = 5 mm is 40)
-  T sound_speed_factor{T(7)};    ///< c0 / sqrt(g h)
-  T absorber_start{T(2)};        ///< entrance of the damping zone, m (beyond the last gauge)
-  T damping_wavelengths{T(1)};   ///< damping zone length, wavelengths
-  T damping_rate{T(10)};         ///< beta, 1/s
+  T depth{T(0.2)};                                        ///< still-water depth h, m
+  T wave_height{T(0.03)};                                 ///< target H, m
+  T period{T(1.2)};                                       ///< T, s
+  T ramp_periods{T(2)};                                   ///< paddle start-up ramp, periods
+  T particles_per_depth{T(20)};                           ///< h / dp (20: dp = 10 mm; the paper's dp = 5 mm is 40)
+  T sound_speed_factor{T(7)};                             ///< c0 / sqrt(g h)
+  T absorber_start{T(2)};                                 ///< entrance of the damping zone, m (beyond the last gauge)
+  T damping_wavelengths{T(1)};                            ///< damping zone length, wavelengths
+  T damping_rate{T(10)};                                  ///< beta, 1/s
   std::vector<T> gauges{T(0.6), T(1.0), T(1.3), T(1.7)};  ///< gauge positions, m
   // plants
-  int plants{1};              ///< number of plants (0: the empty flume)
-  T first_plant_x{T(1.2)};    ///< centre line of the first (upstream) plant, m
-  T spacing{T(0.1)};          ///< distance between neighbouring plants, m
-  T height_ratio{T(0.4)};     ///< blade length / depth, [0.1, 0.9] (paper: 0.32 to 0.5)
+  int plants{1};                         ///< number of plants (0: the empty flume)
+  T first_plant_x{T(1.2)};               ///< centre line of the first (upstream) plant, m
+  T spacing{T(0.1)};                     ///< distance between neighbouring plants, m
+  T height_ratio{T(0.4)};                ///< blade length / depth, [0.1, 0.9] (paper: 0.32 to 0.5)
   BladeModel blade{BladeModel::scaled};  ///< default scaled: the equivalent blade does not run (docs/posidonia.md)
-  int blade_rows{3};          ///< particle rows across the blade (>= 3: the normal needs them)
-  int clamp_rows{3};          ///< rows embedded below the bed (the reflection clamp's images)
+  int blade_rows{3};                     ///< particle rows across the blade (>= 3: the normal needs them)
+  int clamp_rows{3};                     ///< rows embedded below the bed (the reflection clamp's images)
   // the real blade (Table 3)
-  T real_density{T(910)};          ///< kg/m^3
-  T real_youngs_modulus{T(4.7e8)};  ///< Pa
-  T real_thickness{T(1e-4)};       ///< m
-  T poisson_ratio{T(0.3)};         ///< nu from K and E of Table 3 (scaled blade and real blade)
+  T real_density{T(910)};             ///< kg/m^3
+  T real_youngs_modulus{T(4.7e8)};    ///< Pa
+  T real_thickness{T(1e-4)};          ///< m
+  T poisson_ratio{T(0.3)};            ///< nu from K and E of Table 3 (scaled blade and real blade)
   T equivalent_bulk_modulus{T(1e5)};  ///< least K of the equivalent blade, Pa (50x the bed pressure rho g h)
 
   void validate() const {
@@ -86,9 +86,10 @@ struct PosidoniaFlume {
       for (T x : gauges) require_in_range("PosidoniaFlume gauge position (m)", x, T(0), absorber_start);
     if (plants > 0) {
       if (blade_length_rows() < clamp_rows)
-        throw InputError(fmt::format("PosidoniaFlume: the blade has {} rows above the bed (height_ratio {} at h/dp = "
-                                     "{}), fewer than the {} embedded rows it must mirror: raise height_ratio or h/dp",
-                                     blade_length_rows(), height_ratio, particles_per_depth, clamp_rows));
+        throw InputError(
+            fmt::format("PosidoniaFlume: the blade has {} rows above the bed (height_ratio {} at h/dp = "
+                        "{}), fewer than the {} embedded rows it must mirror: raise height_ratio or h/dp",
+                        blade_length_rows(), height_ratio, particles_per_depth, clamp_rows));
       require_in_range("PosidoniaFlume::first_plant_x (m)", first_plant_x, T(4) * dp(), absorber_start);
       const T last = first_plant_x + T(plants - 1) * spacing;
       if (plants > 1)
@@ -161,9 +162,9 @@ template <Real T>
 struct PosidoniaLayout {
   WaveFlumeLayout<T> flume;
   std::int32_t plant_body{WaveFlumeLayout<T>::first_free_body};
-  std::vector<T> plant_x;                         ///< centre lines, m
-  std::vector<std::vector<std::uint32_t>> tips;   ///< ids of each plant's top row
-  std::size_t solid_particles{0};                 ///< including the embedded rows
+  std::vector<T> plant_x;                        ///< centre lines, m
+  std::vector<std::vector<std::uint32_t>> tips;  ///< ids of each plant's top row
+  std::size_t solid_particles{0};                ///< including the embedded rows
 };
 
 /// Fills `system` (empty, on wave_flume_domain(scene.flume())) with the flume and the plants (solid body

@@ -55,11 +55,11 @@ template <int Dim, Real T>
 struct TotalLagrangianParameters {
   Vec<Dim, T> gravity = default_gravity();  ///< body force per unit mass, m/s^2
   T cfl{T(0.3)};                            ///< solid step = cfl h / (c_p + |v|max), (0, 1]
-  bool sub_cycle{true};   ///< true: advance() sub-cycles and the solid does not limit the fluid step
-  T hourglass{T(0.1)};    ///< alpha_hg, hourglass penalty relative to E, [0, 10]
-  T artificial_viscosity{T(0)};  ///< alpha of Monaghan's artificial viscosity, [0, 5]
-  T damping{T(0)};        ///< c_d, mass-proportional velocity damping, 1/s, >= 0 (0 for dynamics)
-  T stretch_limit{T(0)};  ///< stop with BlowUpError when max_stretch() exceeds this (0: off), else > 1
+  bool sub_cycle{true};                     ///< true: advance() sub-cycles and the solid does not limit the fluid step
+  T hourglass{T(0.1)};                      ///< alpha_hg, hourglass penalty relative to E, [0, 10]
+  T artificial_viscosity{T(0)};             ///< alpha of Monaghan's artificial viscosity, [0, 5]
+  T damping{T(0)};                          ///< c_d, mass-proportional velocity damping, 1/s, >= 0 (0 for dynamics)
+  T stretch_limit{T(0)};            ///< stop with BlowUpError when max_stretch() exceeds this (0: off), else > 1
   bool quadratic_correction{true};  ///< gradient exact for quadratic fields (false: Bonet-Lok, exact for linear)
 
   static Vec<Dim, T> default_gravity() {
@@ -124,9 +124,10 @@ class TotalLagrangianSolid {
       for (std::uint32_t k = pairs.offset[a]; k < pairs.offset[a + 1]; ++k)
         m += V0[pairs.neighbor[k]] * (X[pairs.neighbor[k]] - X[a]) * grad0_[k].transpose();
       if (!(std::abs(m.determinant()) > T(1e-3)))
-        throw InputError(fmt::format("TotalLagrangianSolid: particle id {} of body {} has too few neighbours for "
-                                     "the kernel-gradient correction (det M = {}): use h/dp >= 1.2",
-                                     body_.particle_ids()[a], body, m.determinant()));
+        throw InputError(
+            fmt::format("TotalLagrangianSolid: particle id {} of body {} has too few neighbours for "
+                        "the kernel-gradient correction (det M = {}): use h/dp >= 1.2",
+                        body_.particle_ids()[a], body, m.determinant()));
       correction_[a] = m.inverse();
     }
     gradient_weight_.resize(pairs.neighbor.size());
@@ -165,9 +166,10 @@ class TotalLagrangianSolid {
       for (std::size_t j = 0; j < body_.size(); ++j)
         if ((X[j] - image).norm() < tolerance) m = static_cast<std::int64_t>(j);
       if (m < 0 || (X[m] - point).dot(nn) <= T(0))
-        throw InputError(fmt::format("clamp_by_reflection: particle id {} at [{}, {}] has no free particle at its "
-                                     "mirror position: the lattice must be symmetric about the clamp plane",
-                                     body_.particle_ids()[k], X[k][0], X[k][1]));
+        throw InputError(
+            fmt::format("clamp_by_reflection: particle id {} at [{}, {}] has no free particle at its "
+                        "mirror position: the lattice must be symmetric about the clamp plane",
+                        body_.particle_ids()[k], X[k][0], X[k][1]));
       mirror_[k] = m;
       body_.clamp(body_.particle_ids()[k]);
       ++count;
@@ -228,9 +230,10 @@ class TotalLagrangianSolid {
     if (params_.stretch_limit > T(0)) {
       const T s = body_.max_stretch();
       if (s > params_.stretch_limit)
-        throw BlowUpError(fmt::format("solid body {} at t = {:.6g} s: largest stretch between initially "
-                                      "neighbouring particles is {:.4g} > stretch_limit = {:.4g} (the body tore)",
-                                      body_.body(), time + dt, s, params_.stretch_limit));
+        throw BlowUpError(
+            fmt::format("solid body {} at t = {:.6g} s: largest stretch between initially "
+                        "neighbouring particles is {:.4g} > stretch_limit = {:.4g} (the body tore)",
+                        body_.body(), time + dt, s, params_.stretch_limit));
     }
     body_.scatter(p);
     publish(p);
@@ -475,16 +478,16 @@ class TotalLagrangianSolid {
   Parameters params_;
   Kernel kernel_;
   SolidBody<Dim, T> body_;
-  std::vector<Vector> grad0_;         // reference kernel gradient per pair, 1/m^(Dim+1)
-  std::vector<T> w0_;                 // reference kernel value per pair, 1/m^Dim
-  std::vector<Matrix> correction_;    // B_a
+  std::vector<Vector> grad0_;            // reference kernel gradient per pair, 1/m^(Dim+1)
+  std::vector<T> w0_;                    // reference kernel value per pair, 1/m^Dim
+  std::vector<Matrix> correction_;       // B_a
   std::vector<Vector> gradient_weight_;  // corrected gradient weight L_a grad0_ab per pair, 1/m^(Dim+1)
   std::vector<std::uint32_t> reverse_;   // index of the pair (b, a) of each pair (a, b)
   std::vector<std::uint8_t> quadratic_;  // 1 where the weights are exact for quadratic fields
   std::vector<Matrix> F_, P_;            // deformation gradient, PK1 stress (Pa)
   T highest_frequency_{0};               // omega_max of the linearised body with its reflected clamps, rad/s
   std::vector<std::int64_t> mirror_;     // mirror particle of a reflected clamp particle, -1 otherwise
-  std::vector<Vector> a_int_;         // internal acceleration, m/s^2
+  std::vector<Vector> a_int_;            // internal acceleration, m/s^2
   std::size_t sub_steps_{0};
   bool initialised_{false};
 };
