@@ -29,15 +29,15 @@ using TankSimulation = Simulation<System, SymplecticVerlet>;
 
 /// Geometry, resolution and wall model of the tank.
 struct TankConfig {
-  Real depth{0.5};          ///< initial water depth H, m
-  Real width{1.0};          ///< tank width L, m
-  Real wall_height{0.7};    ///< height of the side walls, m
+  Real depth{0.5};               ///< initial water depth H, m
+  Real width{1.0};               ///< tank width L, m
+  Real wall_height{0.7};         ///< height of the side walls, m
   int particles_over_depth{40};  ///< H / dp
   WallModel walls{WallModel::dynamic};
-  Real sound_speed_factor{10};   ///< c0 = factor sqrt(g H) (Monaghan 1994: 10 keeps density variations ~1 %)
-  Real rho0{1000};               ///< kg/m^3
-  Real gravity{9.81};            ///< m/s^2
-  bool depth_scaling{false};     ///< repulsive walls: eps(z) of eq. 22 with h0 = H (off: eps(z) = 1)
+  Real sound_speed_factor{10};  ///< c0 = factor sqrt(g H) (Monaghan 1994: 10 keeps density variations ~1 %)
+  Real rho0{1000};              ///< kg/m^3
+  Real gravity{9.81};           ///< m/s^2
+  bool depth_scaling{false};    ///< repulsive walls: eps(z) of eq. 22 with h0 = H (off: eps(z) = 1)
 
   Real dp() const { return depth / Real(particles_over_depth); }
   Real sound_speed() const { return sound_speed_factor * std::sqrt(gravity * depth); }
