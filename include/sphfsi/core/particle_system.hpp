@@ -85,6 +85,30 @@ class ParticleSystem {
   /// Whether every particle had the same smoothing length at the last update_neighbors().
   bool uniform_smoothing_length() const noexcept { return uniform_h_; }
 
+  /// Throws InputError if two particles of different kinds or bodies lie closer than `fraction` times the smaller
+  /// of their spacings (m / rho)^(1/Dim): overlapping bodies in a scene (checked before the first step). Solid
+  /// particles inside walls are allowed (a clamped end embedded in a wall).
+  /// Neighbours must be current (update_neighbors()).
+  void check_overlaps(T fraction = T(0.4)) const {
+    const auto& p = particles_;
+    for (std::size_t a = 0; a < p.size(); ++a) {
+      const T spacing_a = std::pow(p.mass[a] / p.density[a], T(1) / T(Dim));
+      for_each_neighbor(a, [&](std::size_t b, const Vector&, T r, T) {
+        if (p.kind[a] == p.kind[b] && p.body[a] == p.body[b]) return;
+        const bool embedded = (p.kind[a] == Kind::wall && p.kind[b] == Kind::solid) ||
+                              (p.kind[a] == Kind::solid && p.kind[b] == Kind::wall);
+        if (embedded) return;  // a solid's clamped part may lie inside a wall
+        const T spacing = std::min(spacing_a, std::pow(p.mass[b] / p.density[b], T(1) / T(Dim)));
+        if (r < fraction * spacing)
+          throw InputError(fmt::format(
+              "overlapping bodies: {} particle id {} (body {}) and {} particle id {} (body {}) are {:.3g} m apart; "
+              "particles of different bodies must be at least {} x their spacing ({:.3g} m) apart",
+              kind_name(p.kind[a]), p.id[a], p.body[a], kind_name(p.kind[b]), p.id[b], p.body[b], r, fraction,
+              fraction * spacing));
+      });
+    }
+  }
+
   /// Calls f(j, dx, r, h_ab) for every particle j != i with r = |x_i - x_j| < support * h_ab.
   template <class F>
   void for_each_neighbor(std::size_t i, F&& f) const {

@@ -239,6 +239,7 @@ class Simulation {
     initialised_ = true;
     move_walls(time_);
     evaluate_rates(time_);
+    if (time_ == T(0)) system_.check_overlaps();
   }
 
   System& system_;
