@@ -15,6 +15,7 @@
 #include <sphfsi/integrators/symplectic.hpp>
 #include <sphfsi/io/command_line.hpp>
 #include <sphfsi/io/csv.hpp>
+#include <sphfsi/io/progress.hpp>
 #include <sphfsi/io/vtk_writer.hpp>
 #include <sphfsi/kernel/cubic_spline.hpp>
 #include <sphfsi/scenes/antoci_gate.hpp>
@@ -83,8 +84,10 @@ int run(const Options& opt, const Coupling& coupling) {
   std::size_t max_inside = 0;
   std::string failure;
   const auto start = std::chrono::steady_clock::now();
+  io::ProgressReporter progress(opt.end_time);  // one line in place on a terminal, periodic lines in logs
   try {
     sim.run(opt.end_time, [&](auto& s) {
+      progress(s);
       if (s.time() + 1e-12 < next_sample) return;
       const auto& p = s.system().particles();
       const Vec<2, Scalar> d = scenes::gate_tip_position(p, ids.tip) - tip0;
@@ -105,6 +108,7 @@ int run(const Options& opt, const Coupling& coupling) {
     fmt::print(stderr, "run stopped: {}\n", failure);
     vtk.write(system.particles(), sim.time());
   }
+  progress.finish(sim);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const auto cmp = scenes::compare_gate_tip(record, io::read_csv(opt.data_dir + "/antoci2007_gate_tip_experiment.csv"),
                                             opt.end_time);

@@ -10,6 +10,7 @@
 #include <sphfsi/integrators/symplectic.hpp>
 #include <sphfsi/io/command_line.hpp>
 #include <sphfsi/io/csv.hpp>
+#include <sphfsi/io/progress.hpp>
 #include <sphfsi/io/vtk_writer.hpp>
 #include <sphfsi/kernel/cubic_spline.hpp>
 #include <sphfsi/scenes/dam_break.hpp>
@@ -57,7 +58,9 @@ int main(int argc, char** argv) try {
   scenes::SurgeFrontRecord<Scalar> record;
   Scalar next_sample = 0, next_snapshot = 0;
   const auto start = std::chrono::steady_clock::now();
+  io::ProgressReporter progress(end_T * t_scale);  // one line in place on a terminal, periodic lines in logs
   sim.run(end_T * t_scale, [&](Solver& s) {
+    progress(s);
     const Scalar T = s.time() / t_scale;
     if (T >= next_sample) {
       const Scalar front = scenes::surge_front(s.system().particles()) / scene.a();
@@ -70,6 +73,7 @@ int main(int argc, char** argv) try {
       next_snapshot += end_T / snapshots;
     }
   });
+  progress.finish(sim);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   const auto cmp = scenes::compare_surge_front(record, io::read_csv(data));
