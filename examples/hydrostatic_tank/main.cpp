@@ -24,6 +24,7 @@ int main(int argc, char** argv) try {
   const std::string walls = cli.get("walls", "dynamic", "wall model: dynamic | repulsive");
   cfg.particles_over_depth = static_cast<int>(cli.get_number("resolution", 40, "particles over the water depth"));
   const double end_time = cli.get_number("end-time", 2.0, "simulated time, s (settling)");
+  cfg.smoothing_ratio = cli.get_number("smoothing-ratio", cfg.smoothing_ratio, "smoothing length over spacing h/dp");
   const std::filesystem::path output = cli.get("output", "hydrostatic_tank_output", "output folder");
   const std::string depth_scaling =
       cli.get("depth-scaling", "on", "repulsive walls: eps(z) of eq. 22 with h0 = H, z0 = H (on | off)");

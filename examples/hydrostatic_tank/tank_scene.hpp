@@ -38,10 +38,11 @@ struct TankConfig {
   Real rho0{1000};              ///< kg/m^3
   Real gravity{9.81};           ///< m/s^2
   bool depth_scaling{false};    ///< repulsive walls: eps(z) of eq. 22 with h0 = H (off: eps(z) = 1)
+  Real smoothing_ratio{1.3};    ///< h / dp
 
   Real dp() const { return depth / Real(particles_over_depth); }
   Real sound_speed() const { return sound_speed_factor * std::sqrt(gravity * depth); }
-  Resolution<Real> resolution() const { return {dp(), Real(1.3)}; }
+  Resolution<Real> resolution() const { return {dp(), smoothing_ratio}; }
   /// Period of the gravest vertical acoustic mode (quarter wave between bed and free surface), s.
   Real acoustic_period() const { return Real(4) * depth / sound_speed(); }
 
