@@ -31,6 +31,14 @@ constexpr const char* kind_name(Kind k) noexcept {
   return "unknown";
 }
 
+/// Standard gravity, 9.81 m/s^2 along -z (the last axis): the default body force of fluids and solids.
+template <int Dim, class T>
+Vec<Dim, T> standard_gravity() {
+  Vec<Dim, T> g = Vec<Dim, T>::Zero();
+  g[Dim - 1] = T(-9.81);
+  return g;
+}
+
 /// Dimension and scalar type a scene is built for.
 template <class T>
 concept Real = std::is_same_v<T, float> || std::is_same_v<T, double>;

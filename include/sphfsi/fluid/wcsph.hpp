@@ -45,22 +45,16 @@ enum class WallModel {
 
 template <int Dim, Real T>
 struct FluidParameters {
-  Vec<Dim, T> gravity = default_gravity();  ///< m/s^2
-  T artificial_viscosity{T(0.01)};          ///< alpha of Monaghan's artificial viscosity, [0, 1]
-  T density_diffusion{T(0.1)};              ///< delta of delta-SPH, [0, 1] (0 switches it off)
-  T xsph{T(0)};                             ///< epsilon of XSPH, [0, 1)
-  T kinematic_viscosity{T(0)};              ///< laminar viscosity nu, m^2/s (0: none)
+  Vec<Dim, T> gravity = standard_gravity<Dim, T>();  ///< m/s^2
+  T artificial_viscosity{T(0.01)};                   ///< alpha of Monaghan's artificial viscosity, [0, 1]
+  T density_diffusion{T(0.1)};                       ///< delta of delta-SPH, [0, 1] (0 switches it off)
+  T xsph{T(0)};                                      ///< epsilon of XSPH, [0, 1)
+  T kinematic_viscosity{T(0)};                       ///< laminar viscosity nu, m^2/s (0: none)
   WallModel walls{WallModel::dynamic};
   RepulsiveForceParameters<T> repulsive{};  ///< used when walls == repulsive
   /// Fluid pressure floor, Pa (-inf: none). 0 stops spray clusters from collapsing under negative pressure
   /// (tensile instability, Swegle et al. 1995): water in a thin jet cannot sustain tension.
   T minimum_pressure{-std::numeric_limits<T>::infinity()};
-
-  static Vec<Dim, T> default_gravity() {
-    Vec<Dim, T> g = Vec<Dim, T>::Zero();
-    g[Dim - 1] = T(-9.81);
-    return g;
-  }
 
   void validate() const {
     for (int d = 0; d < Dim; ++d) require_finite("FluidParameters::gravity", gravity[d]);

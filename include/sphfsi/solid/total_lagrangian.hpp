@@ -53,20 +53,15 @@ namespace sphfsi {
 /// Parameters of a TotalLagrangianSolid (designated initialisers; validated by the model's constructor).
 template <int Dim, Real T>
 struct TotalLagrangianParameters {
-  Vec<Dim, T> gravity = default_gravity();  ///< body force per unit mass, m/s^2
-  T cfl{T(0.3)};                            ///< solid step = cfl h / (c_p + |v|max), (0, 1]
-  bool sub_cycle{true};                     ///< true: advance() sub-cycles and the solid does not limit the fluid step
-  T hourglass{T(0.1)};                      ///< alpha_hg, hourglass penalty relative to E, [0, 10]
-  T artificial_viscosity{T(0)};             ///< alpha of Monaghan's artificial viscosity, [0, 5]
-  T damping{T(0)};                          ///< c_d, mass-proportional velocity damping, 1/s, >= 0 (0 for dynamics)
+  Vec<Dim, T> gravity = standard_gravity<Dim, T>();  ///< body force per unit mass, m/s^2
+  T cfl{T(0.3)};                                     ///< solid step = cfl h / (c_p + |v|max), (0, 1]
+  bool sub_cycle{true};             ///< true: advance() sub-cycles and the solid does not limit the fluid step
+  T hourglass{T(0.1)};              ///< alpha_hg, hourglass penalty relative to E, [0, 10]
+  T artificial_viscosity{T(0)};     ///< alpha of Monaghan's artificial viscosity, [0, 5]
+  T damping{T(0)};                  ///< c_d, mass-proportional velocity damping, 1/s, >= 0 (0 for dynamics)
   T stretch_limit{T(0)};            ///< stop with BlowUpError when max_stretch() exceeds this (0: off), else > 1
   bool quadratic_correction{true};  ///< gradient exact for quadratic fields (false: Bonet-Lok, exact for linear)
 
-  static Vec<Dim, T> default_gravity() {
-    Vec<Dim, T> g = Vec<Dim, T>::Zero();
-    g[Dim - 1] = T(-9.81);
-    return g;
-  }
   void validate() const {
     for (int d = 0; d < Dim; ++d) require_finite("TotalLagrangianParameters::gravity (m/s^2)", gravity[d]);
     require_in_range("TotalLagrangianParameters::cfl", cfl, T(1e-6), T(1));

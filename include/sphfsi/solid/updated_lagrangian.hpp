@@ -38,22 +38,17 @@ namespace sphfsi {
 /// Parameters of an UpdatedLagrangianSolid (designated initialisers; validated by the model's constructor).
 template <int Dim, Real T>
 struct UpdatedLagrangianParameters {
-  Vec<Dim, T> gravity = default_gravity();  ///< body force per unit mass, m/s^2
-  T cfl{T(0.3)};                            ///< solid step = cfl h / (c_p + |v|max), (0, 1]
-  bool sub_cycle{true};                     ///< true: advance() sub-cycles and the solid does not limit the fluid step
-  T artificial_viscosity{T(0.5)};           ///< alpha, [0, 5]
-  T artificial_viscosity_beta{T(0)};        ///< beta, [0, 5]
-  T artificial_stress{T(0.3)};              ///< epsilon of Monaghan's artificial stress, [0, 1] (0: off)
-  T artificial_stress_exponent{T(4)};       ///< n of f_ab^n, [1, 10]
-  bool corrected_velocity_gradient{true};   ///< kernel-gradient correction of L (false: original GMS 2001)
-  T damping{T(0)};                          ///< c_d, mass-proportional velocity damping, 1/s, >= 0
-  T stretch_limit{T(0)};  ///< stop with BlowUpError when max_stretch() exceeds this (0: off), else > 1
+  Vec<Dim, T> gravity = standard_gravity<Dim, T>();  ///< body force per unit mass, m/s^2
+  T cfl{T(0.3)};                                     ///< solid step = cfl h / (c_p + |v|max), (0, 1]
+  bool sub_cycle{true};                    ///< true: advance() sub-cycles and the solid does not limit the fluid step
+  T artificial_viscosity{T(0.5)};          ///< alpha, [0, 5]
+  T artificial_viscosity_beta{T(0)};       ///< beta, [0, 5]
+  T artificial_stress{T(0.3)};             ///< epsilon of Monaghan's artificial stress, [0, 1] (0: off)
+  T artificial_stress_exponent{T(4)};      ///< n of f_ab^n, [1, 10]
+  bool corrected_velocity_gradient{true};  ///< kernel-gradient correction of L (false: original GMS 2001)
+  T damping{T(0)};                         ///< c_d, mass-proportional velocity damping, 1/s, >= 0
+  T stretch_limit{T(0)};                   ///< stop with BlowUpError when max_stretch() exceeds this (0: off), else > 1
 
-  static Vec<Dim, T> default_gravity() {
-    Vec<Dim, T> g = Vec<Dim, T>::Zero();
-    g[Dim - 1] = T(-9.81);
-    return g;
-  }
   void validate() const {
     for (int d = 0; d < Dim; ++d) require_finite("UpdatedLagrangianParameters::gravity (m/s^2)", gravity[d]);
     require_in_range("UpdatedLagrangianParameters::cfl", cfl, T(1e-6), T(1));
