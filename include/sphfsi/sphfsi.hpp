@@ -47,6 +47,7 @@
 #include <sphfsi/solid/body.hpp>
 #include <sphfsi/solid/concepts.hpp>
 #include <sphfsi/solid/elastic_material.hpp>
+#include <sphfsi/solid/elastic_rod.hpp>
 #include <sphfsi/solid/total_lagrangian.hpp>
 #include <sphfsi/solid/updated_lagrangian.hpp>
 #include <sphfsi/waves/damping_zone.hpp>

@@ -1,0 +1,517 @@
+// sphfsi: a thin elastic blade as one line of nodes: the planar discrete elastic rod (issue 6).
+//
+// A seagrass blade (Posidonia: t = 0.1 mm, reference paper Table 3) is far thinner than a fluid particle, so it is
+// modelled as a geometrically exact planar Kirchhoff rod (unshearable, extensible; the elastica: Audoly & Pomeau
+// 2010, Elasticity and Geometry, ch. 3) discretised as the discrete elastic rod of Bergou, Wardetzky, Robinson,
+// Audoly & Grinspun (2008, ACM Trans. Graph. 27(3):63, sec. 4: curvature of a vertex from the turning angle between
+// its edges over the vertex's Voronoi length) restricted to a plane, where there is no twist and no material frame.
+//
+// Nodes x_i, i = 0 (base) .. n-1 (tip), in increasing particle id; edges e_j = x_{j+1} - x_j, length l_j, rest
+// length L_j; Voronoi lengths D_i = (L_{i-1} + L_i)/2, D_0 = L_0/2, D_{n-1} = L_{n-2}/2. Section of thickness t and
+// width b: A = b t, I = b t^3 / 12; E_r = E, or E / (1 - nu^2) for a blade in plane strain (cylindrical bending).
+//   node mass            m_i = rho A D_i                                       (lumped, trapezoidal)
+//   axial force          N_j = E_r A (l_j / L_j - 1)                           (tension positive), N
+//   turning angle        phi_i = atan2(e_{i-1} x e_i, e_{i-1} . e_i),   i = 1 .. n-2
+//                        at a clamped end, the angle between the held tangent and the end edge (half cell D_0)
+//   bending moment       M_i = E_r I (phi_i - phi0_i) / D_i                    (phi0: rest shape), N m
+//   stored energy        U = sum_j E_r A (l_j - L_j)^2 / (2 L_j) + sum_i E_r I (phi_i - phi0_i)^2 / (2 D_i)
+// With the edge angle theta_j, d theta_j / d x_{j+1} = -d theta_j / d x_j = e_j^perp / l_j^2 (e^perp = (-e_y, e_x)),
+// dU/d theta_j = tau_j = M_j - M_{j+1} (M = 0 at a free end), so the internal forces f = -dU/dx are, per edge,
+//   f_j += N_j e_j / l_j + tau_j e_j^perp / l_j^2,   f_{j+1} -= the same,
+// and the equation of motion is
+//   m_i dv_i/dt = f_i + m_i [(1 - rho_w / rho) g + a_ext,i] - c_d m_i v_i
+// (buoyancy of the surrounding fluid of density rho_w; a_ext from the couplings; c_d optional, for static runs).
+// Every edge force is an equal and opposite pair and sum_j tau_j telescopes to M_0 - M_{n-1} = 0 for free ends: a
+// free rod conserves linear and angular momentum, and U is invariant under rigid motions (no internal force).
+// The clamp half cell D_0 = L_0/2 makes the static tip deflection under a tip load the trapezoidal rule of
+// int (L-s)^2 ds: relative error +1/(2 n_e^2) with n_e = n-1 edges (docs/thin-blades.md).
+//
+// Time stepping: velocity Verlet (kick-drift-kick, symplectic) sub-cycled inside the outer (fluid) step with the
+// external acceleration held constant. Stability of Verlet needs omega_max dt < 2; Gershgorin bounds on the
+// linearised chain give omega_axial <= 2 c / L_min (c = sqrt(E_r / rho)) and omega_bend <= 4 sqrt(E_r I / (rho A))
+// / L_min^2 (4th-difference stencil, row sum 16), and by Weyl's inequality omega_max^2 <= omega_axial^2 +
+// omega_bend^2. The rod's step is dt = cfl 2 / omega_max (and <= cfl 2 / c_d with damping).
+//
+// The nodes are particles of Kind::solid in the shared ParticleSet: the neighbour search and the couplings see
+// them. In 2D the set holds masses per unit depth (kg/m): a node's particle mass is rho t D_i (its mass over the
+// width b), so the force per unit mass that a 2D coupling writes applies unchanged to the real blade. After every
+// step each node carries p.normal, the unit normal of the blade (left of the base-to-tip tangent); the other face
+// has -p.normal.
+#pragma once
+
+#include <sphfsi/core/error.hpp>
+#include <sphfsi/core/particle_set.hpp>
+#include <sphfsi/core/types.hpp>
+#include <sphfsi/solid/body.hpp>
+#include <sphfsi/solid/elastic_material.hpp>
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace sphfsi {
+
+/// Rectangular cross-section of a blade.
+template <Real T>
+struct RodSection {
+  T thickness{T(1e-4)};  ///< t, m
+  T width{T(8e-3)};      ///< b, m
+
+  void validate() const {
+    require_positive("RodSection::thickness (t, m)", thickness);
+    require_positive("RodSection::width (b, m)", width);
+  }
+  T area() const { return width * thickness; }                                           ///< A = b t, m^2
+  T second_moment() const { return width * thickness * thickness * thickness / T(12); }  ///< I = b t^3/12, m^4
+};
+
+/// Parameters of an ElasticRod (designated initialisers; validated by the model's constructor).
+template <Real T>
+struct ElasticRodParameters {
+  RodSection<T> section{};                       ///< thickness and width
+  Vec<2, T> gravity = standard_gravity<2, T>();  ///< m/s^2
+  T ambient_density{T(0)};                       ///< rho_w of the surrounding fluid (buoyancy), kg/m^3, >= 0
+  bool plane_strain{false};                      ///< E / (1 - nu^2) instead of E (a blade much wider than thick)
+  T cfl{T(0.8)};                                 ///< dt = cfl 2 / omega_max (Verlet limit at 1), (0, 1]
+  bool sub_cycle{true};                          ///< true: advance() sub-cycles, no limit on the outer step
+  T damping{T(0)};                               ///< c_d, mass-proportional damping, 1/s, >= 0 (0: dynamics)
+  T stretch_limit{T(0)};                         ///< BlowUpError above this edge stretch (0: off), else > 1
+
+  void validate() const {
+    section.validate();
+    for (int d = 0; d < 2; ++d) require_finite("ElasticRodParameters::gravity (m/s^2)", gravity[d]);
+    require_non_negative("ElasticRodParameters::ambient_density (rho_w, kg/m^3)", ambient_density);
+    require_in_range("ElasticRodParameters::cfl", cfl, T(1e-6), T(1));
+    require_non_negative("ElasticRodParameters::damping (c_d, 1/s)", damping);
+    if (stretch_limit != T(0))
+      require_in_open_range("ElasticRodParameters::stretch_limit", stretch_limit, T(1), std::numeric_limits<T>::max());
+  }
+};
+
+/// Adds a straight blade of `node_count` equally spaced nodes (Kind::solid, body `body`) from `base` along
+/// `direction` over `length` to the system, base first (increasing ids), with particle masses per unit depth
+/// rho t D_i and smoothing length `smoothing_length` (for the fluid's neighbour search). Returns their ids.
+template <class System>
+std::vector<std::uint32_t> add_elastic_rod(System& system, const Vec<2, typename System::scalar_type>& base,
+                                           const Vec<2, typename System::scalar_type>& direction,
+                                           typename System::scalar_type length, int node_count,
+                                           const ElasticMaterial<typename System::scalar_type>& material,
+                                           const RodSection<typename System::scalar_type>& section,
+                                           typename System::scalar_type smoothing_length, std::int32_t body) {
+  using T = typename System::scalar_type;
+  static_assert(System::dimension == 2, "add_elastic_rod: the elastic rod is planar (2D systems only)");
+  material.validate();
+  section.validate();
+  require_positive("add_elastic_rod: length (m)", length);
+  require_in_range("add_elastic_rod: node_count", node_count, 3, 1 << 24);
+  require_positive("add_elastic_rod: smoothing_length (m)", smoothing_length);
+  require_positive("add_elastic_rod: |direction|", direction.norm());
+  for (int d = 0; d < 2; ++d) require_finite("add_elastic_rod: base (m)", base[d]);
+  const Vec<2, T> e = direction.normalized();
+  const T ds = length / T(node_count - 1);
+  std::vector<std::uint32_t> ids;
+  auto& p = system.particles();
+  for (int i = 0; i < node_count; ++i) {
+    const T voronoi = (i == 0 || i == node_count - 1) ? T(0.5) * ds : ds;
+    const std::size_t slot = p.add(Kind::solid, base + (T(i) * ds) * e, Vec<2, T>::Zero(), material.density,
+                                   material.density * section.thickness * voronoi, smoothing_length, body);
+    ids.push_back(p.id[slot]);
+  }
+  return ids;
+}
+
+/// Planar discrete elastic rod owning the solid particles of one body (a ParticleModel and a SolidModel).
+template <class System>
+class ElasticRod {
+ public:
+  static_assert(System::dimension == 2, "ElasticRod is a planar rod: use a 2D ParticleSystem");
+  static constexpr int Dim = 2;
+  using T = typename System::scalar_type;
+  using Vector = Vec<2, T>;
+  using Matrix = Mat<2, T>;
+  using Parameters = ElasticRodParameters<T>;
+
+  /// Takes the solid particles of `body` as nodes, base to tip in increasing id; their current positions are
+  /// the rest shape (straight or curved). Throws InputError for invalid parameters, fewer than 3 nodes or
+  /// coincident nodes.
+  ElasticRod(const System& system, std::int32_t body, const ElasticMaterial<T>& material, const Parameters& params = {})
+      : material_((material.validate(), material)), params_((params.validate(), params)), body_(body) {
+    const auto& p = system.particles();
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (p.kind[i] == Kind::solid && p.body[i] == body) ids_.push_back(p.id[i]);
+    std::sort(ids_.begin(), ids_.end());
+    const std::size_t n = ids_.size();
+    if (n < 3)
+      throw InputError(
+          fmt::format("ElasticRod: body {} has {} nodes: valid range is [3, inf) (add the nodes with "
+                      "add_elastic_rod before creating the model)",
+                      body, n));
+    local_of_id_.assign(p.size(), -1);
+    x_.resize(n);
+    v_.resize(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      local_of_id_[ids_[k]] = static_cast<std::int64_t>(k);
+      const std::size_t s = p.slot_of_id(ids_[k]);
+      x_[k] = p.position[s];
+      v_[k] = p.velocity[s];
+    }
+    X_ = x_;
+    rest_length_.resize(n - 1);
+    for (std::size_t j = 0; j + 1 < n; ++j) {
+      rest_length_[j] = (X_[j + 1] - X_[j]).norm();
+      if (!(rest_length_[j] > T(0)))
+        throw InputError(
+            fmt::format("ElasticRod: nodes {} and {} of body {} coincide (edge rest length {} m): valid "
+                        "range is (0, inf)",
+                        ids_[j], ids_[j + 1], body, rest_length_[j]));
+    }
+    voronoi_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const T left = i > 0 ? rest_length_[i - 1] : T(0);
+      const T right = i + 1 < n ? rest_length_[i] : T(0);
+      voronoi_[i] = T(0.5) * (left + right);
+    }
+    const T rho_a = material_.density * params_.section.area();
+    mass_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) mass_[i] = rho_a * voronoi_[i];
+    rest_angle_.assign(n, T(0));
+    for (std::size_t i = 1; i + 1 < n; ++i) rest_angle_[i] = turning_angle(X_[i] - X_[i - 1], X_[i + 1] - X_[i]);
+    held_.assign(n, 0);
+    held_tangent_[0] = (X_[1] - X_[0]).normalized();
+    held_tangent_[1] = (X_[n - 1] - X_[n - 2]).normalized();
+    axial_force_.assign(n - 1, T(0));
+    moment_.assign(n, T(0));
+    a_int_.assign(n, Vector::Zero());
+    a_ext_.assign(n, Vector::Zero());
+    const T l_min = *std::min_element(rest_length_.begin(), rest_length_.end());
+    const T e_r = modulus();
+    const T omega_axial = T(2) * std::sqrt(e_r / material_.density) / l_min;
+    const T omega_bend = T(4) * std::sqrt(e_r * params_.section.second_moment() / rho_a) / (l_min * l_min);
+    omega_max_ = std::sqrt(omega_axial * omega_axial + omega_bend * omega_bend);
+  }
+
+  // ---- set-up ----
+  /// Holds the nodes whose reference position satisfies pred at rest at their reference position. A held end
+  /// node (base or tip) also holds the end tangent at its reference direction: that end is clamped (for an end
+  /// that is only pinned, hold it and leave the tangent free with pin_where). Returns the number of held nodes.
+  template <class Predicate>
+  std::size_t clamp_where(Predicate&& pred) {
+    const std::size_t n = ids_.size();
+    for (std::size_t k = 0; k < n; ++k)
+      if (pred(X_[k])) held_[k] = 1;
+    clamped_end_[0] = clamped_end_[0] || held_[0];
+    clamped_end_[1] = clamped_end_[1] || held_[n - 1];
+    return held_count();
+  }
+  /// Holds the nodes whose reference position satisfies pred, without holding the tangent (a pin).
+  template <class Predicate>
+  std::size_t pin_where(Predicate&& pred) {
+    for (std::size_t k = 0; k < ids_.size(); ++k)
+      if (pred(X_[k])) held_[k] = 1;
+    return held_count();
+  }
+  /// Clamps the base (node 0): position and tangent held. Returns the number of held nodes.
+  std::size_t clamp_base() {
+    held_[0] = 1;
+    clamped_end_[0] = true;
+    return held_count();
+  }
+
+  // ---- ParticleModel ----
+  /// Reads the node state and publishes normal, density, pressure and sound speed of the nodes.
+  void compute_rates(System& system, T /*time*/) {
+    gather(system.particles(), false);
+    internal_forces();
+    publish(system.particles());
+  }
+
+  /// +inf when sub-cycling, otherwise the rod's own step over the cfl (the Simulation applies its own CFL).
+  T stable_time_step(const System& /*system*/) const {
+    if (params_.sub_cycle) return std::numeric_limits<T>::infinity();
+    return solid_time_step() / params_.cfl;
+  }
+
+  /// Integrates the rod over [time, time + dt] in ceil(dt / solid_time_step()) velocity-Verlet sub-steps,
+  /// holding the external acceleration found in p.acceleration (force per unit mass) constant.
+  void advance(System& system, T time, T dt) {
+    auto& p = system.particles();
+    gather(p, true);
+    const std::size_t n_sub = detail::sub_step_count(dt, solid_time_step());
+    const T h = dt / T(n_sub);
+    const std::size_t n = ids_.size();
+    const Vector g = body_force();
+    internal_forces();
+    for (std::size_t s = 0; s < n_sub; ++s) {
+      for (std::size_t k = 0; k < n; ++k) {
+        if (held_[k]) {
+          x_[k] = X_[k];
+          v_[k].setZero();
+          continue;
+        }
+        v_[k] += T(0.5) * h * (a_int_[k] + a_ext_[k] + g);
+        x_[k] += h * v_[k];
+      }
+      internal_forces();
+      for (std::size_t k = 0; k < n; ++k)
+        if (!held_[k]) v_[k] += T(0.5) * h * (a_int_[k] + a_ext_[k] + g);
+      check_finite(time + T(s + 1) * h);
+    }
+    sub_steps_ += n_sub;
+    if (params_.stretch_limit > T(0)) {
+      const T stretch = max_stretch();
+      if (stretch > params_.stretch_limit)
+        throw BlowUpError(
+            fmt::format("elastic rod (body {}) at t = {:.6g} s: largest edge stretch {:.4g} > "
+                        "stretch_limit = {:.4g}",
+                        body_, time + dt, stretch, params_.stretch_limit));
+    }
+    scatter(p);
+    publish(p);
+  }
+
+  // ---- SolidModel ----
+  std::int32_t body() const noexcept { return body_; }
+  /// Node ids, base to tip.
+  const std::vector<std::uint32_t>& particle_ids() const noexcept { return ids_; }
+  /// Mean rest edge length ds, m.
+  T reference_spacing() const {
+    T sum = T(0);
+    for (T l : rest_length_) sum += l;
+    return sum / T(rest_length_.size());
+  }
+  const ElasticMaterial<T>& material() const noexcept { return material_; }
+  const Parameters& parameters() const noexcept { return params_; }
+
+  /// The rod's own stable step cfl 2 / omega_max (and cfl 2 / c_d with damping), s.
+  T solid_time_step() const {
+    const T rate = std::max(omega_max_, params_.damping);
+    return params_.cfl * T(2) / rate;
+  }
+
+  /// Stress at the node as a uniaxial tensor along the tangent, sigma = s t (x) t, Pa (tension positive), with s
+  /// the fibre stress of larger magnitude on the two faces: s = N/A + sign(N) |M| (t/2) / I (axial plus bending).
+  Matrix cauchy_stress(std::uint32_t id) const {
+    const std::size_t k = local(id);
+    const T membrane = node_axial_force(k) / params_.section.area();
+    const T bending = std::abs(moment_[k]) * T(0.5) * params_.section.thickness / params_.section.second_moment();
+    const T s = membrane + (membrane >= T(0) ? bending : -bending);
+    const Vector t = tangent(k);
+    return s * t * t.transpose();
+  }
+  /// Largest edge stretch l_j / L_j (1 for the rest length; > 1 in tension).
+  T max_stretch() const {
+    T s = T(0);
+    for (std::size_t j = 0; j + 1 < ids_.size(); ++j) s = std::max(s, (x_[j + 1] - x_[j]).norm() / rest_length_[j]);
+    return s;
+  }
+
+  // ---- diagnostics ----
+  /// Axial force N at a node (mean of its edges), N (tension positive).
+  T axial_force(std::uint32_t id) const { return node_axial_force(local(id)); }
+  /// Bending moment M = E_r I (phi - phi0) / D at a node, N m (positive: the blade bends towards +normal).
+  T bending_moment(std::uint32_t id) const { return moment_[local(id)]; }
+  /// Position of the tip node (last in id order), m.
+  const Vector& tip_position() const { return x_.back(); }
+  /// Rest positions of the nodes, base to tip, m.
+  const std::vector<Vector>& reference_positions() const noexcept { return X_; }
+  /// Current node positions and velocities, base to tip (as of the last compute_rates / advance).
+  const std::vector<Vector>& positions() const noexcept { return x_; }
+  const std::vector<Vector>& velocities() const noexcept { return v_; }
+  /// Node masses m_i = rho A D_i of the real blade (width b), kg.
+  const std::vector<T>& node_masses() const noexcept { return mass_; }
+  /// E_r: E, or E / (1 - nu^2) in plane strain, Pa.
+  T modulus() const { return params_.plane_strain ? material_.plane_strain_modulus() : material_.youngs_modulus; }
+  /// Flexural rigidity E_r I, N m^2.
+  T bending_stiffness() const { return modulus() * params_.section.second_moment(); }
+  /// Upper bound of the highest angular frequency of the linearised rod, rad/s.
+  T highest_frequency_bound() const noexcept { return omega_max_; }
+  /// Body force per unit mass (1 - rho_w / rho) g, m/s^2.
+  Vector body_force() const { return (T(1) - params_.ambient_density / material_.density) * params_.gravity; }
+  /// Kinetic energy sum m v^2 / 2 of the real blade, J.
+  T kinetic_energy() const {
+    T e = T(0);
+    for (std::size_t k = 0; k < ids_.size(); ++k) e += T(0.5) * mass_[k] * v_[k].squaredNorm();
+    return e;
+  }
+  /// Stored elastic energy U (stretching plus bending), J.
+  T strain_energy() const {
+    const std::size_t n = ids_.size();
+    const T ea = modulus() * params_.section.area(), ei = bending_stiffness();
+    T e = T(0);
+    for (std::size_t j = 0; j + 1 < n; ++j) {
+      const T dl = (x_[j + 1] - x_[j]).norm() - rest_length_[j];
+      e += T(0.5) * ea * dl * dl / rest_length_[j];
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      const T dphi = bending_angle(i);
+      e += T(0.5) * ei * dphi * dphi / voronoi_[i];
+    }
+    return e;
+  }
+  /// Potential energy of the body force, -sum m (1 - rho_w/rho) g . x, J.
+  T potential_energy() const {
+    T e = T(0);
+    for (std::size_t k = 0; k < ids_.size(); ++k) e -= mass_[k] * body_force().dot(x_[k]);
+    return e;
+  }
+  std::size_t sub_step_total() const noexcept { return sub_steps_; }
+
+  // ---- checkpoint (io/checkpoint.hpp) ----
+  template <class Writer>
+  void save_checkpoint(Writer& w) const {
+    w.write("elastic_rod.ids", ids_);
+    w.write("elastic_rod.held", held_);
+    w.write("elastic_rod.clamped_ends", std::vector<std::uint8_t>{clamped_end_[0], clamped_end_[1]});
+    w.write("elastic_rod.position", x_);
+    w.write("elastic_rod.velocity", v_);
+    w.write("elastic_rod.sub_steps", static_cast<std::uint64_t>(sub_steps_));
+  }
+  /// Restores the state saved by save_checkpoint; the rod must be built from the same nodes (checked).
+  template <class Reader>
+  void load_checkpoint(Reader& r) {
+    std::vector<std::uint32_t> ids;
+    r.read("elastic_rod.ids", ids);
+    if (ids != ids_)
+      r.fail(fmt::format("elastic rod of body {}: the file holds {} nodes with other ids than this rod's {}", body_,
+                         ids.size(), ids_.size()));
+    std::vector<std::uint8_t> held, ends;
+    r.read_exact("elastic_rod.held", held, ids_.size());
+    r.read_exact("elastic_rod.clamped_ends", ends, 2);
+    std::vector<Vector> x, v;
+    r.read_exact("elastic_rod.position", x, ids_.size());
+    r.read_exact("elastic_rod.velocity", v, ids_.size());
+    std::uint64_t sub_steps = 0;
+    r.read("elastic_rod.sub_steps", sub_steps);
+    held_ = std::move(held);
+    clamped_end_[0] = ends[0] != 0;
+    clamped_end_[1] = ends[1] != 0;
+    x_ = std::move(x);
+    v_ = std::move(v);
+    sub_steps_ = static_cast<std::size_t>(sub_steps);
+    internal_forces();
+  }
+
+ private:
+  static T turning_angle(const Vector& a, const Vector& b) {
+    return std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b));
+  }
+  static Vector perp(const Vector& e) { return Vector(-e.y(), e.x()); }
+
+  std::size_t held_count() const {
+    std::size_t c = 0;
+    for (auto h : held_) c += h;
+    return c;
+  }
+  std::size_t local(std::uint32_t id) const {
+    const std::int64_t k = id < local_of_id_.size() ? local_of_id_[id] : -1;
+    if (k < 0) throw InputError(fmt::format("particle id {} is not a node of the elastic rod (body {})", id, body_));
+    return static_cast<std::size_t>(k);
+  }
+
+  /// phi_i - phi0_i at node i: the turning angle at an interior node, the angle between the held tangent and the
+  /// end edge at a clamped end, 0 at a free end.
+  T bending_angle(std::size_t i) const {
+    const std::size_t n = ids_.size();
+    if (i == 0) return clamped_end_[0] ? turning_angle(held_tangent_[0], x_[1] - x_[0]) : T(0);
+    if (i == n - 1) return clamped_end_[1] ? turning_angle(x_[n - 1] - x_[n - 2], held_tangent_[1]) : T(0);
+    return turning_angle(x_[i] - x_[i - 1], x_[i + 1] - x_[i]) - rest_angle_[i];
+  }
+
+  /// Axial forces, bending moments and the internal (elastic + damping) acceleration at the current state.
+  void internal_forces() {
+    const std::size_t n = ids_.size();
+    const T ea = modulus() * params_.section.area(), ei = bending_stiffness();
+    for (std::size_t i = 0; i < n; ++i) moment_[i] = ei * bending_angle(i) / voronoi_[i];
+    for (auto& a : a_int_) a.setZero();
+    for (std::size_t j = 0; j + 1 < n; ++j) {
+      const Vector e = x_[j + 1] - x_[j];
+      const T l2 = e.squaredNorm(), l = std::sqrt(l2);
+      axial_force_[j] = ea * (l / rest_length_[j] - T(1));
+      const T tau = moment_[j] - moment_[j + 1];
+      const Vector f = (axial_force_[j] / l) * e + (tau / l2) * perp(e);
+      a_int_[j] += f;
+      a_int_[j + 1] -= f;
+    }
+    for (std::size_t i = 0; i < n; ++i) a_int_[i] = a_int_[i] / mass_[i] - params_.damping * v_[i];
+  }
+
+  T node_axial_force(std::size_t k) const {
+    const std::size_t n = ids_.size();
+    if (k == 0) return axial_force_[0];
+    if (k == n - 1) return axial_force_[n - 2];
+    return T(0.5) * (axial_force_[k - 1] + axial_force_[k]);
+  }
+  /// Unit tangent at a node (mean direction of its edges), base to tip.
+  Vector tangent(std::size_t k) const {
+    const std::size_t n = ids_.size();
+    if (k == 0) return (x_[1] - x_[0]).normalized();
+    if (k == n - 1) return (x_[n - 1] - x_[n - 2]).normalized();
+    return ((x_[k] - x_[k - 1]).normalized() + (x_[k + 1] - x_[k]).normalized()).normalized();
+  }
+
+  void gather(const ParticleSet<2, T>& p, bool external) {
+    for (std::size_t k = 0; k < ids_.size(); ++k) {
+      const std::size_t s = p.slot_of_id(ids_[k]);
+      x_[k] = p.position[s];
+      v_[k] = p.velocity[s];
+      if (external) a_ext_[k] = held_[k] ? Vector::Zero() : p.acceleration[s];
+    }
+  }
+  void scatter(ParticleSet<2, T>& p) const {
+    for (std::size_t k = 0; k < ids_.size(); ++k) {
+      const std::size_t s = p.slot_of_id(ids_[k]);
+      p.position[s] = x_[k];
+      p.velocity[s] = v_[k];
+    }
+  }
+  /// Writes the blade normal, density rho / stretch, pressure -(N/A)/2 (the section-mean stress: the bending
+  /// stress averages to zero over the thickness) and the bar wave speed sqrt(E_r / rho) of every node.
+  void publish(ParticleSet<2, T>& p) const {
+    const T c = std::sqrt(modulus() / material_.density);
+    for (std::size_t k = 0; k < ids_.size(); ++k) {
+      const std::size_t s = p.slot_of_id(ids_[k]);
+      const T n_k = node_axial_force(k);
+      p.normal[s] = perp(tangent(k));
+      p.density[s] = material_.density / (T(1) + n_k / (modulus() * params_.section.area()));
+      p.pressure[s] = -T(0.5) * n_k / params_.section.area();
+      p.sound_speed[s] = c;
+    }
+  }
+
+  void check_finite(T time) const {
+    for (std::size_t k = 0; k < ids_.size(); ++k)
+      if (!x_[k].allFinite() || !v_[k].allFinite())
+        throw BlowUpError(
+            fmt::format("elastic rod blow-up at t = {:.6g} s: body {} node id {} (node {} of {}) has a "
+                        "non-finite {}; the particle set holds the state at the start of the outer step",
+                        time, body_, ids_[k], k, ids_.size(), x_[k].allFinite() ? "velocity" : "position"));
+  }
+
+  ElasticMaterial<T> material_;
+  Parameters params_;
+  std::int32_t body_;
+  std::vector<std::uint32_t> ids_;                 // node ids, base to tip
+  std::vector<std::int64_t> local_of_id_;          // node index of a particle id, -1 if not a node
+  std::vector<Vector> X_, x_, v_;                  // rest and current positions (m), velocities (m/s)
+  std::vector<T> rest_length_;                     // L_j, m
+  std::vector<T> voronoi_;                         // D_i, m
+  std::vector<T> mass_;                            // m_i = rho A D_i, kg
+  std::vector<T> rest_angle_;                      // phi0_i, rad
+  std::vector<std::uint8_t> held_;                 // 1: node held at rest at X
+  std::array<bool, 2> clamped_end_{false, false};  // base, tip: tangent held
+  std::array<Vector, 2> held_tangent_{};           // reference end tangents
+  std::vector<T> axial_force_;                     // N_j, N
+  std::vector<T> moment_;                          // M_i, N m
+  std::vector<Vector> a_int_, a_ext_;              // internal and external acceleration, m/s^2
+  T omega_max_{0};                                 // rad/s
+  std::size_t sub_steps_{0};
+};
+
+}  // namespace sphfsi

@@ -1,0 +1,410 @@
+// Tests of the planar discrete elastic rod (solid/elastic_rod.hpp, issue 6): input validation, the elastica
+// under a large tip load, the first bending frequency against Euler-Bernoulli, energy, momentum, rigid motions,
+// sub-cycling with the external force held over the outer step, blade normals and checkpointing.
+#include <sphfsi/core/particle_system.hpp>
+#include <sphfsi/eos/linear.hpp>
+#include <sphfsi/io/checkpoint.hpp>
+#include <sphfsi/kernel/wendland_c2.hpp>
+#include <sphfsi/solid/concepts.hpp>
+#include <sphfsi/solid/elastic_rod.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+namespace {
+
+using System = sphfsi::ParticleSystem<2, double, sphfsi::WendlandC2<2>, sphfsi::LinearEos<double>>;
+using Rod = sphfsi::ElasticRod<System>;
+using V = sphfsi::Vec<2, double>;
+
+static_assert(sphfsi::SolidModel<Rod, System>);
+
+// A blade with L/t = 100: the axial strain of the largest tip load (alpha = 10) is alpha (t/L)^2 / 12 = 8e-5,
+// so the extensible rod is the inextensible elastica to that relative accuracy.
+constexpr double L = 0.1;       // m
+constexpr double b = 0.01;      // m
+constexpr double thick = 1e-3;  // m
+const sphfsi::ElasticMaterial<double> blade{.density = 1000, .youngs_modulus = 1e7, .poisson_ratio = 0.3};
+const sphfsi::RodSection<double> section{.thickness = thick, .width = b};
+const double EI = blade.youngs_modulus * section.second_moment();                            // N m^2
+const double rhoA = blade.density * section.area();                                          // kg/m
+const double omega1 = 1.8751040687 * 1.8751040687 * std::sqrt(EI / (rhoA * L * L * L * L));  // rad/s
+
+System make_system() {
+  return System(sphfsi::Domain<2, double>(V(-1, -1), V(1, 1)), sphfsi::LinearEos<double>(1000, 10));
+}
+
+System make_blade(int edges) {
+  System system = make_system();
+  sphfsi::add_elastic_rod(system, V(0, 0), V(1, 0), L, edges + 1, blade, section, L / edges, 0);
+  return system;
+}
+
+sphfsi::ElasticRodParameters<double> weightless(double damping = 0) {
+  return {.section = section, .gravity = V::Zero(), .damping = damping};
+}
+
+/// Elastica of a cantilever under a dead tip load normal to its clamp, alpha = P L^2 / (E I): with the
+/// deflection angle theta(s), s in units of L, theta'' = -alpha cos(theta), theta(0) = 0, theta'(1) = 0. Shooting
+/// on theta'(0) in (0, alpha] by bisection, RK4 with 4000 steps (error ~ 1e-12). Returns {deflection/L,
+/// (L - x_tip)/L}.
+std::pair<double, double> elastica_tip_load(double alpha) {
+  const auto shoot = [alpha](double slope) {
+    std::array<double, 4> y{0, slope, 0, 0};  // theta, theta', x, deflection
+    const auto rate = [alpha](const std::array<double, 4>& s) {
+      return std::array<double, 4>{s[1], -alpha * std::cos(s[0]), std::cos(s[0]), std::sin(s[0])};
+    };
+    const int steps = 4000;
+    const double h = 1.0 / steps;
+    for (int i = 0; i < steps; ++i) {
+      const auto k1 = rate(y);
+      std::array<double, 4> y2, y3, y4;
+      for (int c = 0; c < 4; ++c) y2[c] = y[c] + 0.5 * h * k1[c];
+      const auto k2 = rate(y2);
+      for (int c = 0; c < 4; ++c) y3[c] = y[c] + 0.5 * h * k2[c];
+      const auto k3 = rate(y3);
+      for (int c = 0; c < 4; ++c) y4[c] = y[c] + h * k3[c];
+      const auto k4 = rate(y4);
+      for (int c = 0; c < 4; ++c) y[c] += h / 6 * (k1[c] + 2 * k2[c] + 2 * k3[c] + k4[c]);
+    }
+    return y;
+  };
+  double lo = 0, hi = alpha;  // theta'(1) < 0 at slope 0, > 0 at slope alpha
+  for (int i = 0; i < 60; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (shoot(mid)[1] < 0 ? lo : hi) = mid;
+  }
+  const auto y = shoot(0.5 * (lo + hi));
+  return {y[3], 1 - y[2]};
+}
+
+/// Static tip deflection and shortening (over L) of the rod with `edges` edges under the dead tip load alpha,
+/// by dynamic relaxation (damping 2 omega1) until the largest node speed is below 1e-11 L omega1.
+std::pair<double, double> rod_tip_load(int edges, double alpha) {
+  System system = make_blade(edges);
+  Rod rod(system, 0, blade, weightless(2 * omega1));
+  rod.clamp_base();
+  const double P = alpha * EI / (L * L);
+  const std::uint32_t tip = rod.particle_ids().back();
+  const double dt = 200 * rod.solid_time_step();
+  double t = 0;
+  for (int step = 0; t < 40 * 2 * std::numbers::pi / omega1; ++step) {
+    system.particles().acceleration[system.particles().slot_of_id(tip)] = V(0, -P / rod.node_masses().back());
+    rod.advance(system, t, dt);
+    t += dt;
+    double v_max = 0;
+    for (const auto& v : rod.velocities()) v_max = std::max(v_max, v.norm());
+    if (step > 10 && v_max < 1e-11 * L * omega1) break;
+  }
+  return {-rod.tip_position().y() / L, (L - rod.tip_position().x()) / L};
+}
+
+/// Period of the free vibration started in the first Euler-Bernoulli mode with tip speed v_tip, from the
+/// up-crossings of the tip deflection over three periods (crossing times interpolated linearly).
+double rod_period(int edges, double v_tip) {
+  System system = make_blade(edges);
+  const double kL = 1.8751040687;
+  const double ratio = (std::cos(kL) + std::cosh(kL)) / (std::sin(kL) + std::sinh(kL));
+  const auto mode = [&](double x) {
+    const double k = kL / L;
+    return (std::cos(k * x) - std::cosh(k * x)) - ratio * (std::sin(k * x) - std::sinh(k * x));
+  };
+  auto& p = system.particles();
+  for (std::size_t i = 0; i < p.size(); ++i) p.velocity[i] = V(0, v_tip * mode(p.position[i].x()) / mode(L));
+  Rod rod(system, 0, blade, weightless());
+  rod.clamp_base();
+  const double period = 2 * std::numbers::pi / omega1;
+  const double dt = period / 4000;
+  double t = 0, y_old = 0;
+  std::vector<double> up;
+  while (t < 3.2 * period) {
+    rod.advance(system, t, dt);
+    t += dt;
+    const double y = rod.tip_position().y();
+    if (y_old < 0 && y >= 0) up.push_back(t - dt * y / (y - y_old));
+    y_old = y;
+  }
+  REQUIRE(up.size() >= 3);
+  return (up.back() - up.front()) / double(up.size() - 1);
+}
+
+}  // namespace
+
+TEST_CASE("elastic rod: invalid input is rejected with the parameter named", "[rod]") {
+  System system = make_blade(4);
+  const auto message = [&](auto&& make) {
+    try {
+      make();
+    } catch (const sphfsi::InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no InputError");
+  };
+  auto params = weightless();
+  params.section.thickness = 0;
+  CHECK_THAT(message([&] { Rod(system, 0, blade, params); }), Catch::Contains("thickness"));
+  params = weightless();
+  params.section.width = -1;
+  CHECK_THAT(message([&] { Rod(system, 0, blade, params); }), Catch::Contains("width"));
+  params = weightless();
+  params.cfl = 1.5;
+  CHECK_THAT(message([&] { Rod(system, 0, blade, params); }), Catch::Contains("cfl"));
+  params = weightless();
+  params.damping = -1;
+  CHECK_THAT(message([&] { Rod(system, 0, blade, params); }), Catch::Contains("damping"));
+  params = weightless();
+  params.stretch_limit = 0.5;
+  CHECK_THAT(message([&] { Rod(system, 0, blade, params); }), Catch::Contains("stretch_limit"));
+  params = weightless();
+  params.ambient_density = -1;
+  CHECK_THAT(message([&] { Rod(system, 0, blade, params); }), Catch::Contains("ambient_density"));
+  auto soft = blade;
+  soft.youngs_modulus = -1;
+  CHECK_THAT(message([&] { Rod(system, 0, soft, weightless()); }), Catch::Contains("youngs_modulus"));
+  soft = blade;
+  soft.poisson_ratio = 0.5;
+  CHECK_THAT(message([&] { Rod(system, 0, soft, weightless()); }), Catch::Contains("poisson_ratio"));
+  CHECK_THAT(message([&] { Rod(system, 7, blade, weightless()); }), Catch::Contains("[3, inf)"));
+  CHECK_THAT(message([&] { sphfsi::add_elastic_rod(system, V(0, 0), V(1, 0), L, 2, blade, section, 0.01, 1); }),
+             Catch::Contains("node_count"));
+  CHECK_THAT(message([&] { sphfsi::add_elastic_rod(system, V(0, 0), V(1, 0), -L, 5, blade, section, 0.01, 1); }),
+             Catch::Contains("length"));
+  System twice = make_system();
+  twice.particles().add(sphfsi::Kind::solid, V(0, 0), V::Zero(), 1000, 1e-3, 0.01, 0);
+  twice.particles().add(sphfsi::Kind::solid, V(0, 0), V::Zero(), 1000, 1e-3, 0.01, 0);
+  twice.particles().add(sphfsi::Kind::solid, V(0.1, 0), V::Zero(), 1000, 1e-3, 0.01, 0);
+  CHECK_THAT(message([&] { Rod(twice, 0, blade, weightless()); }), Catch::Contains("coincide"));
+}
+
+TEST_CASE("elastic rod: the reference elastica solver reproduces the small-load limit", "[rod]") {
+  // Linear beam theory: deflection alpha/3, shortening (from the slope) alpha^2 / 15, relative corrections O(alpha^2).
+  const auto [d, s] = elastica_tip_load(1e-3);
+  CHECK(d == Approx(1e-3 / 3).epsilon(1e-5));
+  CHECK(s == Approx(1e-6 / 15).epsilon(1e-4));
+}
+
+TEST_CASE("elastic rod: large-deflection cantilever under a tip load matches the elastica", "[rod]") {
+  // Expected discretisation error: in the linear limit the discrete tip deflection is exactly the trapezoidal rule
+  // of int_0^L (L - s)^2 ds / EI (clamp half cell D_0 = ds/2), i.e. +1/(2 n^2) relative for n edges; the scheme is
+  // second order, so the error must fall by about 4 per doubling of n at any load.
+  for (double alpha : {0.1, 1.0, 10.0}) {
+    const auto [d_ref, s_ref] = elastica_tip_load(alpha);
+    std::vector<double> error;
+    for (int edges : {10, 20, 40}) {
+      const auto [d, s] = rod_tip_load(edges, alpha);
+      INFO("alpha = " << alpha << ", edges = " << edges << ": deflection " << d << " (elastica " << d_ref
+                      << "), shortening " << s << " (elastica " << s_ref << ")");
+      // Bound: twice the linear trapezoidal estimate 1/(2 n^2), plus 1e-4 for extensibility (strain 8e-5 at alpha 10).
+      CHECK(std::abs(d - d_ref) / d_ref < 1.0 / (edges * edges) + 1e-4);
+      CHECK(std::abs(s - s_ref) / s_ref < 2.0 / (edges * edges) + 2e-4);
+      error.push_back(std::abs(d - d_ref) / d_ref);
+    }
+    INFO("alpha = " << alpha << ": errors " << error[0] << ", " << error[1] << ", " << error[2]);
+    CHECK(std::log2(error[0] / error[1]) == Approx(2).margin(0.3));
+    CHECK(std::log2(error[1] / error[2]) == Approx(2).margin(0.3));
+  }
+}
+
+TEST_CASE("elastic rod: first bending frequency converges to Euler-Bernoulli", "[rod]") {
+  // Small amplitude (tip 1e-3 L): geometric nonlinearity changes the period by O(amplitude^2) = 1e-6. Rotary
+  // inertia, left out of Euler-Bernoulli and of the rod, would be (t/L)^2 = 1e-4. The discretisation is second
+  // order: |error| < 1/n^2 (the static flexibility alone gives -1/(4 n^2) on the frequency) and falls ~4x per doubling.
+  const double period_eb = 2 * std::numbers::pi / omega1;
+  std::vector<double> error;
+  for (int edges : {10, 20, 40}) {
+    const double period = rod_period(edges, 1e-3 * L * omega1);
+    error.push_back(period / period_eb - 1);
+    INFO("edges = " << edges << ": period " << period << " s, Euler-Bernoulli " << period_eb << " s");
+    CHECK(std::abs(error.back()) < 1.0 / (edges * edges));
+  }
+  INFO("errors " << error[0] << ", " << error[1] << ", " << error[2]);
+  CHECK(std::log2(error[0] / error[1]) == Approx(2).margin(0.3));
+  CHECK(std::log2(error[1] / error[2]) == Approx(2).margin(0.3));
+}
+
+TEST_CASE("elastic rod: undamped energy has no drift and its error is the integrator's O(dt^2)", "[rod]") {
+  // Large amplitude (tip speed 0.5 L omega1, tip excursion about 0.5 L): kinetic + stored energy of velocity Verlet
+  // oscillates about the conserved shadow energy with an amplitude proportional to dt^2; halving the rod's step
+  // (cfl 0.8 -> 0.4) must divide the band by 4 (3 to 5 allowed), and the band stays below 1e-4 of the energy.
+  const auto band = [](double cfl) {
+    System system = make_blade(20);
+    auto& p = system.particles();
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const double s = p.position[i].x() / L;
+      p.velocity[i] = V(0, 0.5 * L * omega1 * s * s);
+    }
+    auto params = weightless();
+    params.cfl = cfl;
+    Rod rod(system, 0, blade, params);
+    rod.clamp_base();
+    rod.compute_rates(system, 0);
+    const double e0 = rod.kinetic_energy() + rod.strain_energy();
+    const double dt = 2 * std::numbers::pi / omega1 / 500;
+    double worst = 0, t = 0;
+    for (int step = 0; step < 1500; ++step, t += dt) {
+      rod.advance(system, t, dt);
+      worst = std::max(worst, std::abs(rod.kinetic_energy() + rod.strain_energy() - e0) / e0);
+    }
+    return worst;
+  };
+  const double coarse = band(0.8), fine = band(0.4);
+  INFO("relative energy band: cfl 0.8 " << coarse << ", cfl 0.4 " << fine);
+  CHECK(coarse < 1e-4);
+  CHECK(coarse / fine > 3);
+  CHECK(coarse / fine < 5);
+}
+
+TEST_CASE("elastic rod: a free rod conserves linear and angular momentum", "[rod]") {
+  System system = make_blade(12);
+  auto& p = system.particles();
+  for (std::size_t i = 0; i < p.size(); ++i) {  // bent and spinning, deterministic
+    const double s = p.position[i].x() / L;
+    p.position[i].y() += 0.2 * L * s * s;
+    p.velocity[i] = V(0.3 * std::sin(7.0 * s), 0.5 * std::cos(5.0 * s));
+  }
+  Rod rod(system, 0, blade, weightless());
+  rod.compute_rates(system, 0);
+  const auto momenta = [&] {
+    V linear = V::Zero();
+    double angular = 0, scale = 0;
+    for (std::size_t k = 0; k < rod.positions().size(); ++k) {
+      const double m = rod.node_masses()[k];
+      const V& x = rod.positions()[k];
+      const V& v = rod.velocities()[k];
+      linear += m * v;
+      angular += m * (x.x() * v.y() - x.y() * v.x());
+      scale += m * v.norm();
+    }
+    return std::tuple{linear, angular, scale};
+  };
+  const auto [p0, l0, scale] = momenta();
+  double t = 0;
+  const double dt = 2e-3;
+  for (int step = 0; step < 200; ++step, t += dt) rod.advance(system, t, dt);
+  const auto [p1, l1, unused] = momenta();
+  CHECK(rod.sub_step_total() > 1000);
+  CHECK((p1 - p0).norm() < 1e-12 * scale);
+  CHECK(std::abs(l1 - l0) < 1e-10 * scale * L);
+}
+
+TEST_CASE("elastic rod: a rigid motion of a curved rod gives no internal force", "[rod]") {
+  System system = make_system();
+  const int n = 15;
+  auto& p = system.particles();
+  for (int i = 0; i < n; ++i) {  // a quarter circle at rest: the rest shape is curved
+    const double a = 0.5 * std::numbers::pi * i / (n - 1);
+    p.add(sphfsi::Kind::solid, V(L * std::cos(a), L * std::sin(a)), V::Zero(), blade.density, 1e-3, 0.01, 0);
+  }
+  Rod rod(system, 0, blade, weightless());
+  const double angle = 0.7;
+  const V shift(0.05, -0.02);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const V x = p.position[i];
+    p.position[i] =
+        V(std::cos(angle) * x.x() - std::sin(angle) * x.y(), std::sin(angle) * x.x() + std::cos(angle) * x.y()) + shift;
+  }
+  const std::vector<V> before = p.position;
+  double t = 0;
+  for (int step = 0; step < 50; ++step, t += 1e-3) rod.advance(system, t, 1e-3);
+  CHECK(rod.sub_step_total() > 500);
+  double moved = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) moved = std::max(moved, (p.position[i] - before[i]).norm());
+  CHECK(moved < 1e-12 * L);
+  CHECK(rod.strain_energy() < 1e-20);
+  for (auto id : rod.particle_ids()) {
+    CHECK(std::abs(rod.axial_force(id)) < 1e-9 * blade.youngs_modulus * section.area());
+    CHECK(std::abs(rod.bending_moment(id)) < 1e-9 * EI / L);
+  }
+}
+
+TEST_CASE("elastic rod: sub-cycling with the external force held over the outer step", "[rod]") {
+  // A blade driven by a state-dependent external force, a normal drag towards a current U with relaxation rate k,
+  // written into p.acceleration once per outer step as a coupling would. Outer step = 50 rod steps against outer
+  // step = rod step. Holding the force for dt_outer is a first-order hold: it lags the force by dt_outer / 2, so the
+  // tip paths may differ by about k dt_outer / 2 of the tip excursion; the test allows k dt_outer.
+  const double k = 0.2 * omega1, U = 1.0;  // 1/s, m/s
+  const int ratio = 50;
+  const auto run = [&](int rod_steps_per_outer, double dt_rod) {
+    System system = make_blade(20);
+    Rod rod(system, 0, blade, weightless());
+    rod.clamp_base();
+    rod.compute_rates(system, 0);
+    const double dt = rod_steps_per_outer * dt_rod;
+    auto& p = system.particles();
+    std::vector<V> path;
+    for (int step = 0; step < 500 * ratio / rod_steps_per_outer; ++step) {
+      for (auto id : rod.particle_ids()) {
+        const std::size_t s = p.slot_of_id(id);
+        const double u_n = (U * V(0, 1) - p.velocity[s]).dot(p.normal[s]);
+        p.acceleration[s] = k * u_n * p.normal[s];
+      }
+      rod.advance(system, step * dt, dt);
+      if ((step + 1) % (ratio / rod_steps_per_outer) == 0) path.push_back(rod.tip_position());
+    }
+    CHECK(rod.sub_step_total() == 500 * ratio);
+    return path;
+  };
+  System probe = make_blade(20);
+  const double dt_rod = Rod(probe, 0, blade, weightless()).solid_time_step();
+  const auto sub_cycled = run(ratio, dt_rod), global = run(1, dt_rod);
+  REQUIRE(sub_cycled.size() == global.size());
+  double difference = 0, excursion = 0;
+  for (std::size_t i = 0; i < global.size(); ++i) {
+    difference = std::max(difference, (sub_cycled[i] - global[i]).norm());
+    excursion = std::max(excursion, (global[i] - V(L, 0)).norm());
+  }
+  INFO("tip excursion " << excursion << " m, largest difference " << difference << " m, k dt_outer "
+                        << k * ratio * dt_rod);
+  CHECK(excursion > 0.1 * L);
+  CHECK(difference < k * ratio * dt_rod * excursion);
+}
+
+TEST_CASE("elastic rod: nodes carry the blade normal, stress and checkpoint state", "[rod]") {
+  System system = make_blade(10);
+  Rod rod(system, 0, blade, weightless(2 * omega1));
+  rod.clamp_base();
+  auto& p = system.particles();
+  const std::uint32_t tip = rod.particle_ids().back();
+  double t = 0;
+  for (int step = 0; step < 50; ++step, t += 1e-2) {
+    p.acceleration[p.slot_of_id(tip)] = V(0, -2 * EI / (L * L) / rod.node_masses().back());
+    rod.advance(system, t, 1e-2);
+  }
+  const auto& ids = rod.particle_ids();
+  for (std::size_t k = 0; k + 1 < ids.size(); ++k) {  // unit normal, perpendicular to the blade at every node
+    const V n = p.normal[p.slot_of_id(ids[k])];
+    const V edge = (rod.positions()[k + 1] - rod.positions()[k]).normalized();
+    CHECK(n.norm() == Approx(1).epsilon(1e-12));
+    CHECK(std::abs(n.dot(edge)) < 0.2);              // the node normal averages its two edges (turning angle < 0.4 rad)
+    CHECK(n.x() * edge.y() - n.y() * edge.x() < 0);  // left of the base-to-tip tangent
+  }
+  // Near the clamp, tension-free bending: fibre stress |M| (t/2) / I along the tangent.
+  const auto sigma = rod.cauchy_stress(ids[1]);
+  const double fibre = std::abs(rod.bending_moment(ids[1])) * 0.5 * thick / section.second_moment();
+  CHECK(std::abs(sigma.trace()) == Approx(fibre).epsilon(0.02));
+  CHECK(rod.max_stretch() > 1);
+  CHECK(rod.max_stretch() < 1 + 1e-4);
+
+  sphfsi::io::CheckpointWriter w;
+  rod.save_checkpoint(w);
+  System copy_system = make_blade(10);
+  Rod copy(copy_system, 0, blade, weightless(2 * omega1));
+  sphfsi::io::CheckpointReader r(w.bytes().data(), w.bytes().size(), "memory");
+  copy.load_checkpoint(r);
+  CHECK(r.at_end());
+  CHECK(copy.sub_step_total() == rod.sub_step_total());
+  CHECK((copy.tip_position() - rod.tip_position()).norm() == 0);
+  CHECK(copy.strain_energy() == rod.strain_energy());
+  System other = make_blade(11);
+  Rod wrong(other, 0, blade, weightless());
+  sphfsi::io::CheckpointReader r2(w.bytes().data(), w.bytes().size(), "memory");
+  CHECK_THROWS_AS(wrong.load_checkpoint(r2), sphfsi::InputError);
+}
