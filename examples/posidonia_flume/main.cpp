@@ -113,6 +113,7 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
   const waves::Wavemaker<T> maker(g.wave);
   sim.set_wall_motion(layout.flume.paddle_body, maker.template piston_motion<2>());
   const auto wave = maker.wave();
+  sim.set_expected_flow_speed(wave.surface_orbital_velocity(g.wave.wave_height));  // for the c0 check
 
   CaseResult r;
   r.fluid = system.particles().count(Kind::fluid);

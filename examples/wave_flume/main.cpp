@@ -75,6 +75,7 @@ int run(const Options& o) {
   else sim.set_wall_kinematics(layout.paddle_body, maker.template flap_kinematics<2>(layout.paddle_x, T(0)));
 
   const auto wave = maker.wave();
+  sim.set_expected_flow_speed(wave.surface_orbital_velocity(g.wave.wave_height));  // for the c0 check
   const std::vector<T> gauge_x = scenes::wave_flume_gauges(g, o.gauges);
   const double x_last = double(gauge_x.back());
   const double end_time = o.end_time > 0 ? o.end_time

@@ -815,3 +815,57 @@ TEST_CASE("Robustness: mass is conserved exactly and a closed tank never gains e
 }
 
 }  // namespace
+
+// ---------------------------------------------------------------------------------------------------------------
+// (f) A reference sound speed too low for the flow is warned about (a warning, not an error: users lower c0 on
+//     purpose, as the reference paper did, and must see what it costs).
+
+TEST_CASE("Robustness: a reference sound speed too low for the flow is warned about", "[robustness][sound_speed]") {
+  using Sim = Simulation<System2, SymplecticVerlet>;
+  std::vector<std::string> warnings;
+  const auto collect = [&](const std::string& w) { warnings.push_back(w); };
+
+  SECTION("c0 = 15 m/s is above 10 sqrt(g D) = 10.3 m/s for the 0.11 m column: no warning") {
+    System2 system(tank_domain, water);
+    build_dam_break(system);
+    Sim sim(system, FluidParameters<2, T>{});
+    sim.set_warning_handler(collect);
+    for (int s = 0; s < 20; ++s) sim.step();
+    CHECK(warnings.empty());
+  }
+  SECTION("c0 = 3 m/s: warned before the first step, naming c0, its value and the valid range") {
+    System2 system(tank_domain, Tait<T>(1000, 3));
+    build_dam_break(system);
+    Sim sim(system, FluidParameters<2, T>{});
+    sim.set_warning_handler(collect);
+    sim.step();
+    REQUIRE(warnings.size() == 1);
+    CHECK_THAT(warnings[0], Catch::Contains("reference sound speed c0 = 3 m/s") && Catch::Contains("valid range") &&
+                                Catch::Contains("c0 >= 10.3"));
+  }
+  SECTION("an expected flow speed replaces the long-wave estimate") {
+    System2 system(tank_domain, water);
+    build_dam_break(system);
+    Sim sim(system, FluidParameters<2, T>{});
+    sim.set_warning_handler(collect);
+    sim.set_expected_flow_speed(2.0);  // c0 = 15 < 20
+    sim.step();
+    REQUIRE(warnings.size() == 1);
+    CHECK_THAT(warnings[0], Catch::Contains("expected flow speed 2 m/s"));
+  }
+  SECTION("the flow reaching Mach 0.2 is warned about once, with the time and the speed") {
+    System2 system(tank_domain, Tait<T>(1000, 4));  // the collapsing column reaches ~1 m/s within 0.1 s
+    build_dam_break(system);
+    Sim sim(system, FluidParameters<2, T>{});
+    sim.set_warning_handler(collect);
+    sim.run(0.15);
+    REQUIRE(warnings.size() == 2);  // the start-of-run estimate, then the measured Mach number, once
+    CHECK_THAT(warnings[1], Catch::Contains("is Mach 0.2") && Catch::Contains("raise c0 to at least"));
+  }
+  SECTION("an empty handler is rejected") {
+    System2 system(tank_domain, water);
+    Sim sim(system, FluidParameters<2, T>{});
+    CHECK_THROWS_WITH(sim.set_warning_handler({}), Catch::Contains("handler must be callable"));
+    CHECK_THROWS_WITH(sim.set_expected_flow_speed(-1), Catch::Contains("set_expected_flow_speed"));
+  }
+}

@@ -44,6 +44,14 @@ class CoupledBody {
     solid_.advance(system, time, dt);
   }
 
+  // ---- checkpoint (io/checkpoint.hpp): the couplings keep no state between steps, the solid does ----
+  template <class Writer>
+    requires requires(const Solid& s, Writer& w) { s.save_checkpoint(w); }
+  void save_checkpoint(Writer& w) const { solid_.save_checkpoint(w); }
+  template <class Reader>
+    requires requires(Solid& s, Reader& r) { s.load_checkpoint(r); }
+  void load_checkpoint(Reader& r) { solid_.load_checkpoint(r); }
+
   Solid& solid() noexcept { return solid_; }
   const Solid& solid() const noexcept { return solid_; }
   const Coupling& coupling() const noexcept { return coupling_; }

@@ -5,14 +5,17 @@
 #pragma once
 
 #include <sphfsi/core/error.hpp>
+#include <sphfsi/core/parallel.hpp>
 #include <sphfsi/core/types.hpp>
 #include <sphfsi/fluid/wcsph.hpp>
 #include <sphfsi/integrators/concepts.hpp>
 
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <limits>
 #include <map>
+#include <string>
 #include <tuple>
 #include <utility>
 #include <vector>
@@ -86,6 +89,20 @@ class Simulation {
   std::size_t step_count() const noexcept { return steps_; }
   T last_time_step() const noexcept { return dt_; }
 
+  /// Receives the run's warnings (a reference sound speed too low for the flow, see check_sound_speed); the
+  /// default prints them to stderr. A handler may log them, collect them or throw to make them fatal.
+  void set_warning_handler(std::function<void(const std::string&)> handler) {
+    if (!handler) throw InputError("set_warning_handler: the handler must be callable");
+    warn_ = std::move(handler);
+  }
+
+  /// The flow's speed scale U for the sound-speed check, where the default estimate (the long-wave speed
+  /// sqrt(g D) of the fluid's depth D) does not apply, e.g. small waves in a deep flume (their orbital velocity).
+  void set_expected_flow_speed(T speed) {
+    require_positive("Simulation::set_expected_flow_speed speed (m/s)", speed);
+    expected_speed_ = speed;
+  }
+
   /// Moves all wall particles of `body` rigidly with the given motion (a wavemaker paddle, a piston).
   void set_wall_motion(std::int32_t body, PrescribedMotion<Dim, T> motion) {
     if (!motion.displacement || !motion.velocity)
@@ -110,6 +127,7 @@ class Simulation {
     time_ += dt;
     dt_ = dt;
     ++steps_;
+    if (!mach_warned_) check_mach_number();
     return dt;
   }
 
@@ -239,7 +257,57 @@ class Simulation {
     initialised_ = true;
     move_walls(time_);
     evaluate_rates(time_);
-    if (time_ == T(0)) system_.check_overlaps();
+    if (time_ == T(0)) {
+      system_.check_overlaps();
+      check_sound_speed();
+    }
+  }
+
+  /// Weak compressibility needs c0 >= 10 U for the flow's speed scale U (density errors Ma^2 / 2 <= 0.5 %).
+  /// Before the first step U is estimated as the larger of the largest fluid speed and the long-wave speed
+  /// sqrt(|g| D), D the fluid's extent along gravity (Monaghan 1994; DualSPHysics's coefsound rule).
+  void check_sound_speed() {
+    const auto& p = system_.particles();
+    const Vector g = fluid_.parameters().gravity;
+    const T g_norm = g.norm();
+    T lowest = std::numeric_limits<T>::max(), highest = std::numeric_limits<T>::lowest(), v_max = T(0);
+    bool any_fluid = false;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      if (p.kind[i] != Kind::fluid) continue;
+      any_fluid = true;
+      v_max = std::max(v_max, p.velocity[i].norm());
+      if (g_norm > T(0)) {
+        const T depth = -p.position[i].dot(g) / g_norm;
+        lowest = std::min(lowest, depth);
+        highest = std::max(highest, depth);
+      }
+    }
+    if (!any_fluid) return;
+    const T wave_speed = g_norm > T(0) ? std::sqrt(g_norm * (highest - lowest)) : T(0);
+    const T speed = std::max(v_max, expected_speed_ > T(0) ? expected_speed_ : wave_speed);
+    const T c0 = system_.eos().reference_sound_speed();
+    if (c0 < T(10) * speed)
+      warn_(
+          fmt::format("reference sound speed c0 = {:.4g} m/s is below 10 x the expected flow speed ({:.3g} m/s: "
+                      "largest fluid speed {:.3g} m/s, {} {:.3g} m/s): valid range c0 >= {:.4g} m/s for density "
+                      "errors below 0.5 %",
+                      c0, speed, v_max, expected_speed_ > T(0) ? "expected flow speed" : "long-wave speed sqrt(g D)",
+                      expected_speed_ > T(0) ? expected_speed_ : wave_speed, T(10) * speed));
+  }
+
+  /// Once per run: the flow has reached Mach 0.2 (density errors Ma^2 / 2 of 2 %, four times the design value).
+  void check_mach_number() {
+    const auto& p = system_.particles();
+    const T v_max = parallel_max(p.size(), T(0),
+                                 [&](std::size_t i) { return p.kind[i] == Kind::fluid ? p.velocity[i].norm() : T(0); });
+    const T c0 = system_.eos().reference_sound_speed();
+    if (!(v_max > T(0.2) * c0)) return;
+    mach_warned_ = true;
+    warn_(
+        fmt::format("at t = {:.6g} s the largest fluid speed {:.3g} m/s is Mach {:.3g} against the reference sound "
+                    "speed c0 = {:.4g} m/s: density errors of order Ma^2 / 2 = {:.2g} %; raise c0 to at least "
+                    "{:.4g} m/s (10 x the flow speed)",
+                    time_, v_max, v_max / c0, c0, T(50) * (v_max / c0) * (v_max / c0), T(10) * v_max));
   }
 
   System& system_;
@@ -253,6 +321,11 @@ class Simulation {
   T end_limit_ = std::numeric_limits<T>::max();
   std::size_t steps_{0};
   bool initialised_{false};
+  bool mach_warned_{false};
+  T expected_speed_{0};  // m/s, 0: estimate sqrt(g D)
+  std::function<void(const std::string&)> warn_ = [](const std::string& message) {
+    std::fprintf(stderr, "warning: %s\n", message.c_str());
+  };
 };
 
 }  // namespace sphfsi

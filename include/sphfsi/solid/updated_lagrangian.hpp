@@ -214,6 +214,51 @@ class UpdatedLagrangianSolid {
   T stress_work() const noexcept { return work_; }
   std::size_t sub_step_total() const noexcept { return sub_steps_; }
 
+  // ---- checkpoint (io/checkpoint.hpp) ----
+  /// Saves the evolved state besides the particle arrays: density, deviatoric stress, the internal acceleration
+  /// of the last sub-step (it holds the half-step velocity's viscous terms), the accumulated stress work and the
+  /// positions at the last neighbour-list build (the list is rebuilt from them, so the pair order, and with it
+  /// the summation order, is the one of the uninterrupted run).
+  template <class Writer>
+  void save_checkpoint(Writer& w) const {
+    const auto prefix = fmt::format("updated_lagrangian_solid.{}.", body_.body());
+    w.write(prefix + "particle_count", static_cast<std::uint64_t>(body_.size()));
+    w.write(prefix + "initialised", static_cast<std::uint8_t>(initialised_ ? 1 : 0));
+    w.write(prefix + "sub_steps", static_cast<std::uint64_t>(sub_steps_));
+    w.write(prefix + "density", rho_);
+    w.write(prefix + "deviatoric_stress", S_);
+    w.write(prefix + "internal_acceleration", a_int_);
+    w.write(prefix + "stress_work", work_);
+    w.write(prefix + "positions_at_list_build", x_at_build_);
+  }
+  /// Restores the state saved by save_checkpoint into a solid built by the same scene (same body and particles).
+  template <class Reader>
+  void load_checkpoint(Reader& r) {
+    const auto prefix = fmt::format("updated_lagrangian_solid.{}.", body_.body());
+    const std::size_t n = body_.size();
+    std::uint64_t count = 0, sub_steps = 0;
+    std::uint8_t initialised = 0;
+    r.read(prefix + "particle_count", count);
+    if (count != n)
+      r.fail(fmt::format("solid body {} was saved with {} particles, this scene built {}", body_.body(), count, n));
+    r.read(prefix + "initialised", initialised);
+    r.read(prefix + "sub_steps", sub_steps);
+    r.read_exact(prefix + "density", rho_, n);
+    r.read_exact(prefix + "deviatoric_stress", S_, n);
+    r.read_exact(prefix + "internal_acceleration", a_int_, n);
+    r.read(prefix + "stress_work", work_);
+    std::vector<Vector> x_at_build;
+    r.read(prefix + "positions_at_list_build", x_at_build);
+    initialised_ = initialised != 0;
+    sub_steps_ = static_cast<std::size_t>(sub_steps);
+    if (initialised_) {
+      if (x_at_build.size() != n) r.fail(fmt::format("'{}positions_at_list_build' has the wrong length", prefix));
+      x_at_build_ = std::move(x_at_build);
+      pairs_ = detail::build_pair_list<Dim, T>(x_at_build_, body_.smoothing_length(), static_cast<T>(Kernel::support),
+                                               skin_);
+    }
+  }
+
  private:
   std::size_t local(std::uint32_t id) const {
     const auto k = body_.local_index(id);

@@ -32,6 +32,9 @@ struct LinearWave {
   T group_velocity;     ///< c_g, m/s
 
   T kh() const { return wave_number * depth; }
+  /// Amplitude of the horizontal orbital velocity at the still-water surface for a wave of height H (m):
+  /// (H / 2) omega / tanh(k h), m/s (Dean & Dalrymple 1991, sec. 4.4).
+  T surface_orbital_velocity(T height) const { return T(0.5) * height * angular_frequency / std::tanh(kh()); }
 };
 
 /// Solves omega^2 = g k tanh(k h) for k by Newton's method on F(x) = x tanh x - omega^2 h / g, x = k h, from
