@@ -69,10 +69,10 @@ int run(const Options& opt, const Coupling& coupling) {
   Simulation<System, SymplecticVerlet, Gate> sim(system, scene.fluid(), {}, Gate(coupling, std::move(solid)));
 
   fmt::print(
-      "Antoci gate, {} coupling, {} solid: dp = {:.4g} m, {} fluid, {} wall, {} solid particles; c0 fluid {} m/s, "
-      "solid P-wave {:.3g} m/s\n",
+      "Antoci gate, {} coupling, {} solid: dp = {:.4g} m (gate {:.4g} m), {} fluid, {} wall, {} solid particles; "
+      "c0 fluid {} m/s, solid P-wave {:.3g} m/s\n",
       Coupling::name, std::is_same_v<Solid, TotalLagrangian> ? "total-Lagrangian" : "updated-Lagrangian", scene.dp(),
-      system.particles().count(Kind::fluid), system.particles().count(Kind::wall),
+      scene.solid_dp(), system.particles().count(Kind::fluid), system.particles().count(Kind::wall),
       system.particles().count(Kind::solid), scene.fluid_sound_speed, scene.solid_material().p_wave_speed());
 
   std::filesystem::create_directories(opt.output);
@@ -146,6 +146,8 @@ int main(int argc, char** argv) try {
   const std::string solid = cli.get("solid", "tl", "solid model: tl (total Lagrangian) | ul (updated Lagrangian)");
   opt.scene.particles_across =
       cli.get_number("resolution", 80, "particles across the water column A/dp (multiple of 20)");
+  opt.scene.solid_refinement = static_cast<int>(
+      cli.get_number("solid-refinement", 1, "gate particle spacing dp / this: 1, 2 or 4 (finer solid than fluid)"));
   opt.scene.fluid_sound_speed = cli.get_number("fluid-sound-speed", 20, "fluid reference sound speed c0, m/s");
   opt.scene.youngs_modulus = cli.get_number("youngs-modulus", 1.2e7, "gate Young's modulus E, Pa");
   opt.end_time = cli.get_number("end-time", 0.4, "simulated time, s");
@@ -166,8 +168,11 @@ int main(int argc, char** argv) try {
   repulsive.local_depth = opt.scene.column_height;
   // Strength k of eq. 19 such that the still column is in equilibrium with the gate at t = 0 (first fluid row at
   // dp from the gate's surface particles): 0.0036 for c0 = 20 m/s, instead of the paper's 0.01 which kicks the gate.
-  repulsive.strength = repulsive_strength_for_rest_gap(opt.scene.column_height, opt.scene.gravity,
-                                                       opt.scene.fluid_sound_speed, opt.scene.smoothing_ratio, 1.0);
+  // A finer gate (spacing ds = dp / r) has its surface particles ds / 2 inside its face: the first fluid row is
+  // (dp + ds) / 2 from them, and a fluid-solid pair uses the averaged smoothing length h_ab = (h_f + h_s) / 2.
+  const Scalar fine = (1 + 1 / Scalar(opt.scene.solid_refinement)) / 2;
+  repulsive.strength = repulsive_strength_for_rest_gap(
+      opt.scene.column_height, opt.scene.gravity, opt.scene.fluid_sound_speed, opt.scene.smoothing_ratio * fine, fine);
   const bool tl = solid == "tl";
   if (coupling == "stress")
     return tl ? run<TotalLagrangian>(opt, StressContinuity<Scalar>{})

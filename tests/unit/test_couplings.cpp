@@ -8,6 +8,7 @@
 #include <sphfsi/integrators/simulation.hpp>
 #include <sphfsi/integrators/symplectic.hpp>
 #include <sphfsi/kernel/cubic_spline.hpp>
+#include <sphfsi/scenes/antoci_gate.hpp>
 #include <sphfsi/scenes/builders.hpp>
 #include <sphfsi/scenes/solid_builders.hpp>
 #include <sphfsi/solid/total_lagrangian.hpp>
@@ -129,4 +130,43 @@ TEST_CASE("solid surface normals point out of a block", "[coupling]") {
     }
   }
   CHECK(n_surface == 2 * 12 + 2 * 2);
+}
+
+TEST_CASE("Antoci gate scene: a gate finer than the fluid keeps its mass, clamp plane and tip row",
+          "[coupling][scene]") {
+  using Scene = scenes::AntociGate<double>;
+  for (const int r : {1, 2, 4}) {
+    Scene scene;
+    scene.particles_across = 60;  // dp = 1.67 mm: three gate rows at r = 1, twelve at r = 4
+    scene.solid_refinement = r;
+    System system(scene.domain(), Tait<double>(1000, 20));
+    const auto ids = scenes::build_antoci_gate(system, scene);
+    const auto& p = system.particles();
+    double mass = 0, h = 0, lowest = 1;
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      if (p.kind[i] != Kind::solid) continue;
+      mass += p.mass[i];
+      h = p.smoothing_length[i];
+      lowest = std::min(lowest, p.position[i][1]);
+      ++n;
+    }
+    INFO("solid_refinement " << r);
+    const double ds = scene.dp() / r;
+    const double gate_height = scene.clamp_height() + scene.clamp_rows * scene.dp() - scene.gap();
+    CHECK(mass == Approx(scene.solid_density * scene.gate_thickness * gate_height).epsilon(1e-9));
+    CHECK(h == Approx(scene.smoothing_ratio * ds));
+    CHECK(lowest == Approx(scene.gap() + 0.5 * ds));
+    CHECK(ids.tip.size() == static_cast<std::size_t>(std::lround(scene.gate_thickness / ds)));
+    CHECK(n == ids.tip.size() * static_cast<std::size_t>(std::lround(gate_height / ds)));
+  }
+  Scene thin;
+  thin.particles_across = 40;  // two fluid spacings across the gate: too few rows unless the gate is finer
+  CHECK_THROWS_WITH(thin.validate(), Catch::Contains("needs >= 3 particle rows (has 2)"));
+  thin.solid_refinement = 2;
+  CHECK_NOTHROW(thin.validate());
+  Scene bad;
+  bad.solid_refinement = 3;
+  CHECK_THROWS_WITH(bad.validate(),
+                    Catch::Contains("AntociGate::solid_refinement = 3") && Catch::Contains("1, 2 and 4"));
 }

@@ -35,7 +35,8 @@ struct AntociGate {
   // Resolution.
   T particles_across{T(80)};  ///< A / dp (80: dp = 1.25 mm, 4 particle rows across the gate)
   T smoothing_ratio{T(1.3)};  ///< h / dp
-  int clamp_rows{3};          ///< rows of gate particles above L held by the clamp
+  int clamp_rows{3};          ///< rows of fluid spacing dp above L held by the clamp
+  int solid_refinement{1};    ///< the gate's particle spacing is dp / solid_refinement (1, 2 or 4; issue 9)
   T gravity{T(9.81)};
 
   void validate() const {
@@ -48,13 +49,18 @@ struct AntociGate {
     require_positive("AntociGate::fluid_sound_speed (m/s)", fluid_sound_speed);
     require_in_range("AntociGate::particles_across (A/dp)", particles_across, T(20), T(2000));
     require_in_range("AntociGate::clamp_rows", clamp_rows, 1, 10);
-    solid_material().validate();
-    const T rows = gate_thickness / dp();
-    if (std::abs(rows - std::round(rows)) > T(1e-6) || rows < T(2.5))
+    if (solid_refinement != 1 && solid_refinement != 2 && solid_refinement != 4)
       throw InputError(
-          fmt::format("AntociGate: gate_thickness / dp = {} must be a whole number >= 3 (choose "
-                      "particles_across as a multiple of {})",
-                      rows, column_width / gate_thickness));
+          fmt::format("AntociGate::solid_refinement = {} is not supported: valid values are 1, 2 and 4 "
+                      "(gate spacing dp, dp / 2, dp / 4)",
+                      solid_refinement));
+    solid_material().validate();
+    const T rows = gate_thickness / dp(), solid_rows = gate_thickness / solid_dp();
+    if (std::abs(rows - std::round(rows)) > T(1e-6) || solid_rows < T(2.5))
+      throw InputError(
+          fmt::format("AntociGate: gate_thickness / dp = {} must be a whole number and the gate needs >= 3 "
+                      "particle rows (has {}): choose particles_across as a multiple of {}",
+                      rows, solid_rows, column_width / gate_thickness));
     const T max_speed = std::sqrt(T(2) * gravity * column_height);
     if (fluid_sound_speed < T(10) * max_speed)
       fmt::print(stderr,
@@ -63,7 +69,8 @@ struct AntociGate {
                  fluid_sound_speed, T(10) * max_speed);
   }
   T dp() const { return column_width / particles_across; }
-  T gap() const { return dp(); }  ///< free end to floor
+  T solid_dp() const { return dp() / T(solid_refinement); }  ///< the gate's particle spacing, m
+  T gap() const { return dp(); }                             ///< free end to floor
   /// Height of the clamp plane: the gate's free part spans round(L/dp) particle rows above the gap.
   T clamp_height() const { return gap() + std::round(gate_length / dp()) * dp(); }
   ElasticMaterial<T> solid_material() const {
@@ -110,13 +117,14 @@ AntociGateIds build_antoci_gate(System& system, const AntociGate<typename System
   for_each_lattice_point<2, T>(V(x_gate, clamp_top), V(x_gate + g.gate_thickness, top), dp, [&](const V& x) {
     system.particles().add(Kind::wall, x, V::Zero(), rho_w, rho_w * dp * dp, res.h(), 0);
   });
-  // The gate: free part [gap, gap + L] and clamped rows above it.
+  // The gate: free part [gap, gap + L] and clamped rows above it, at its own spacing ds = dp / solid_refinement
+  // with h = smoothing_ratio ds (each particle carries its own mass and smoothing length).
   AntociGateIds ids;
-  const T rho_s = g.solid_density;
-  for_each_lattice_point<2, T>(V(x_gate, g.gap()), V(x_gate + g.gate_thickness, clamp_top), dp, [&](const V& x) {
+  const T rho_s = g.solid_density, ds = g.solid_dp(), h_s = g.smoothing_ratio * ds;
+  for_each_lattice_point<2, T>(V(x_gate, g.gap()), V(x_gate + g.gate_thickness, clamp_top), ds, [&](const V& x) {
     const std::size_t slot =
-        system.particles().add(Kind::solid, x, V::Zero(), rho_s, rho_s * dp * dp, res.h(), ids.gate_body);
-    if (x[1] < g.gap() + dp) ids.tip.push_back(system.particles().id[slot]);
+        system.particles().add(Kind::solid, x, V::Zero(), rho_s, rho_s * ds * ds, h_s, ids.gate_body);
+    if (x[1] < g.gap() + ds) ids.tip.push_back(system.particles().id[slot]);
   });
   return ids;
 }
