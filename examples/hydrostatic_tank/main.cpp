@@ -28,7 +28,21 @@ int main(int argc, char** argv) try {
   const std::filesystem::path output = cli.get("output", "hydrostatic_tank_output", "output folder");
   const std::string depth_scaling =
       cli.get("depth-scaling", "on", "repulsive walls: eps(z) of eq. 22 with h0 = H, z0 = H (on | off)");
+  const std::string correction = cli.get("gradient-correction", "near-walls",
+                                         "kernel-gradient correction of the pressure gradient (Bonet & Lok 1999): "
+                                         "none | near-walls (fluid next to repulsive walls) | everywhere");
+  const std::string masses = cli.get("masses", "consistent",
+                                     "particle masses: consistent (rho(z) dp^2: m / rho = dp^2) | uniform (rho0 dp^2)");
   if (!cli.finish()) return 0;
+  if (masses != "consistent" && masses != "uniform")
+    throw InputError(fmt::format("--masses = '{}' is invalid: valid values are consistent, uniform", masses));
+  cfg.consistent_masses = masses == "consistent";
+  if (correction == "none") cfg.gradient_correction = GradientCorrection::none;
+  else if (correction == "near-walls") cfg.gradient_correction = GradientCorrection::near_repulsive_walls;
+  else if (correction == "everywhere") cfg.gradient_correction = GradientCorrection::everywhere;
+  else
+    throw InputError(fmt::format(
+        "--gradient-correction = '{}' is invalid: valid values are none, near-walls, everywhere", correction));
   if (walls != "dynamic" && walls != "repulsive")
     throw InputError(fmt::format("--walls = '{}' is invalid: valid values are dynamic, repulsive", walls));
   if (depth_scaling != "on" && depth_scaling != "off")
@@ -46,12 +60,12 @@ int main(int argc, char** argv) try {
       walls, cfg.depth, cfg.width, cfg.dp(), system.particles().count(Kind::fluid),
       system.particles().count(Kind::wall), cfg.sound_speed(), cfg.acoustic_period());
 
-  io::CsvWriter probe_csv(
-      output / "probe.csv",
-      {"t", "p_probe", "p_theory", "relative_error", "surface", "max_speed", "kinetic_energy", "particles_lost"},
-      fmt::format("hydrostatic tank, {} walls, probe at x = {} m, z = {} m; p_theory = rho0 g "
-                  "(surface - z), surface = SPH volume / width",
-                  walls, probe[0], probe[1]));
+  io::CsvWriter probe_csv(output / "probe.csv",
+                          {"t", "p_probe", "p_theory", "relative_error", "band_error", "surface", "max_speed",
+                           "kinetic_energy", "particles_lost"},
+                          fmt::format("hydrostatic tank, {} walls, probe at x = {} m, z = {} m; p_theory = rho0 g "
+                                      "(surface - z), surface = SPH volume / width",
+                                      walls, probe[0], probe[1]));
   const double interval = 0.01;  // s between probe samples
   double next_sample = 0;
   auto sample = [&](TankSimulation& s) {
@@ -59,8 +73,11 @@ int main(int argc, char** argv) try {
     next_sample += interval;
     const double surface = free_surface_height(system, cfg);
     const double p_sph = shepard_pressure(system, probe), p_th = hydrostatic_pressure(cfg, surface, probe[1]);
-    probe_csv.write_row({s.time(), p_sph, p_th, (p_sph - p_th) / p_th, surface, max_fluid_speed(system),
-                         fluid_kinetic_energy(system), double(particles_outside(system, cfg))});
+    const BandAverage band = band_average_pressure(system, cfg, probe[1], 0.1 * cfg.depth);
+    const double band_th = hydrostatic_pressure(cfg, surface, band.elevation);
+    probe_csv.write_row({s.time(), p_sph, p_th, (p_sph - p_th) / p_th, (band.pressure - band_th) / band_th, surface,
+                         max_fluid_speed(system), fluid_kinetic_energy(system),
+                         double(particles_outside(system, cfg))});
   };
 
   const auto start = std::chrono::steady_clock::now();
@@ -88,6 +105,12 @@ int main(int argc, char** argv) try {
       "mid-depth pressure: SPH {:.2f} Pa, rho0 g (H_s - z) = {:.2f} Pa, error {:+.3f} % "
       "(vs initial H: {:+.3f} %)\n",
       p_sph, hydrostatic_pressure(cfg, surface, probe[1]), 100 * error, 100 * error_initial_h);
+  const BandAverage band = band_average_pressure(system, cfg, probe[1], 0.1 * cfg.depth);
+  const double band_theory = hydrostatic_pressure(cfg, surface, band.elevation);
+  fmt::print(
+      "band average (|z - H/2| <= H/10, central half, {} particles): {:.2f} Pa at z = {:.4f} m, "
+      "rho0 g (H_s - z) = {:.2f} Pa, error {:+.3f} %\n",
+      band.particles, band.pressure, band.elevation, band_theory, 100 * (band.pressure - band_theory) / band_theory);
   fmt::print("max fluid speed {:.3e} m/s, kinetic energy {:.3e} J/m, particles lost {}\n", max_fluid_speed(system),
              fluid_kinetic_energy(system), lost);
   fmt::print("lowest fluid particle above the bed: {:.3f} dp\n", lowest_fluid_height(system, cfg) / cfg.dp());

@@ -32,11 +32,14 @@ def plot(folder, plt):
     profile, profile_title = read_csv(os.path.join(folder, "profile.csv"))
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.2))
     t = probe["t"][1:]  # the first sample is the initial state before any evaluation (no pressure yet)
-    ax1.plot(t, [100 * e for e in probe["relative_error"][1:]], lw=1)
+    ax1.plot(t, [100 * e for e in probe["relative_error"][1:]], lw=1, label="probe (Shepard average at L/2, H/2)")
+    if "band_error" in probe:
+        ax1.plot(t, [100 * e for e in probe["band_error"][1:]], lw=1, alpha=0.8,
+                 label="band average (|z - H/2| <= H/10, central half)")
     ax1.axhspan(-2, 2, color="green", alpha=0.12, label="2 % band")
     ax1.set_xlabel("t (s)")
     ax1.set_ylabel("mid-depth pressure error (%)")
-    ax1.set_title("probe: (p_SPH - rho0 g (H_s - z)) / rho0 g (H_s - z)", fontsize=9)
+    ax1.set_title("(p_SPH - rho0 g (H_s - z)) / rho0 g (H_s - z)", fontsize=9)
     ax1.legend(loc="best", fontsize=8)
     ax1.grid(alpha=0.3)
     ax2.plot([p / 1000 for p in profile["p_theory"]], profile["z"], "k-", label="rho0 g (H_s - z)")

@@ -39,6 +39,12 @@ struct TankConfig {
   Real gravity{9.81};           ///< m/s^2
   bool depth_scaling{false};    ///< repulsive walls: eps(z) of eq. 22 with h0 = H (off: eps(z) = 1)
   Real smoothing_ratio{1.3};    ///< h / dp
+  /// FluidParameters::gradient_correction: Bonet-Lok corrected pressure gradient for fluid particles whose kernel
+  /// is cut by a repulsive wall (no effect with dynamic walls, which fill the kernel).
+  GradientCorrection gradient_correction{GradientCorrection::near_repulsive_walls};
+  /// m = rho(z) dp^2, so that the SPH volume m / rho of every particle is the dp^2 it occupies on the lattice
+  /// (false: m = rho0 dp^2 for all, volumes smaller than the lattice cell by the hydrostatic compression).
+  bool consistent_masses{true};
 
   Real dp() const { return depth / Real(particles_over_depth); }
   Real sound_speed() const { return sound_speed_factor * std::sqrt(gravity * depth); }
@@ -63,6 +69,7 @@ inline FluidParameters<2, Real> fluid_parameters(const TankConfig& cfg) {
   FluidParameters<2, Real> fluid;
   fluid.gravity = Vector(0, -cfg.gravity);
   fluid.walls = cfg.walls;
+  fluid.gradient_correction = cfg.gradient_correction;
   fluid.repulsive.boundary_spacing = repulsive_wall_spacing(cfg.width, cfg.resolution());
   fluid.repulsive.strength =
       repulsive_strength_for_rest_gap(cfg.depth, cfg.gravity, cfg.sound_speed(), cfg.resolution().smoothing_ratio);
@@ -83,6 +90,10 @@ inline System make_tank(const TankConfig& cfg) {
   add_fluid_block(system, Vector(0, 0), Vector(cfg.width, cfg.depth), res, cfg.depth, cfg.gravity);
   add_box_walls(system, Vector(0, 0), Vector(cfg.width, cfg.wall_height), res, cfg.walls);
   set_hydrostatic_wall_density(system, cfg.depth, cfg.gravity);
+  if (cfg.consistent_masses) {
+    auto& p = system.particles();
+    for (std::size_t i = 0; i < p.size(); ++i) p.mass[i] = p.density[i] * cfg.dp() * cfg.dp();
+  }
   return system;
 }
 
@@ -102,6 +113,33 @@ inline Real shepard_pressure(const System& system, const Vector& x) {
     den += w;
   }
   return den > 0 ? num / den : Real(0);
+}
+
+/// Volume average of the fluid pressure over the band |z - z_c| <= half_height, x in the central half of the tank:
+///   p_band = sum_b p_b V_b / sum_b V_b,  z_band = sum_b z_b V_b / sum_b V_b  (V_b = m_b / rho_b).
+/// A hydrostatic (linear) field averages to its value at z_band, so p_band is compared with rho0 g (H_s - z_band).
+/// Unlike the point probe it averages over many particles (a few hundred at 40 particles over depth), so the
+/// particle-scale pressure noise of a disordered particle set averages out.
+struct BandAverage {
+  Real pressure;   ///< Pa
+  Real elevation;  ///< volume-weighted mean z, m
+  std::size_t particles;
+};
+inline BandAverage band_average_pressure(const System& system, const TankConfig& cfg, Real z_c, Real half_height) {
+  const auto& p = system.particles();
+  Real pv = 0, zv = 0, v = 0;
+  std::size_t n = 0;
+  for (std::size_t b = 0; b < p.size(); ++b) {
+    if (p.kind[b] != Kind::fluid) continue;
+    const Vector& x = p.position[b];
+    if (std::abs(x[1] - z_c) > half_height || x[0] < Real(0.25) * cfg.width || x[0] > Real(0.75) * cfg.width) continue;
+    const Real vol = p.mass[b] / p.density[b];
+    pv += p.pressure[b] * vol;
+    zv += x[1] * vol;
+    v += vol;
+    ++n;
+  }
+  return v > 0 ? BandAverage{pv / v, zv / v, n} : BandAverage{0, z_c, 0};
 }
 
 /// Settled free-surface height H_s, m: the water's SPH volume per unit width, sum_b m_b / rho_b / L. It counts the

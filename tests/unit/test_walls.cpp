@@ -102,36 +102,88 @@ TEST_CASE("repulsive walls: every face is a full row with its own normal; rest-g
   CHECK_THROWS_AS(repulsive_strength_for_rest_gap(-1.0, 9.81, 10.0, 1.3), InputError);
 }
 
-// Coarse hydrostatic tank, 20 particles over the 0.5 m depth, settled for 0.5 s (5.6 periods 4H/c0 of the gravest
-// vertical acoustic mode; the column starts in hydrostatic equilibrium, so settling is the decay of the small
-// start-up transient). Tolerance on the mid-depth pressure: the free surface of a particle column is resolved only
-// to within half a particle spacing (where in its layer of thickness dp the surface lies is not known), so
-// rho0 g (H_s - z) at depth H/2 is uncertain by (dp/2) / (H/2) = dp / H = 1/N = 5 % at N = 20 (2.5 % at N = 40,
-// 1.25 % at N = 80: the example's 2 % at N = 40 is the stricter requirement of the issue).
-TEST_CASE("hydrostatic tank, coarse: hydrostatic mid-depth pressure, no particle lost", "[walls][tank]") {
-  for (WallModel walls : {WallModel::dynamic, WallModel::repulsive}) {
-    tank::TankConfig cfg;
-    cfg.particles_over_depth = 20;
-    cfg.walls = walls;
-    cfg.depth_scaling = walls == WallModel::repulsive;
-    INFO((walls == WallModel::dynamic ? "dynamic walls" : "repulsive walls"));
-    auto system = tank::make_tank(cfg);
-    tank::TankSimulation sim(system, tank::fluid_parameters(cfg));
-    std::size_t lost = 0;
-    sim.run(0.5, [&](tank::TankSimulation&) { lost = std::max(lost, tank::particles_outside(system, cfg)); });
-    const double surface = tank::free_surface_height(system, cfg);
-    const double z = 0.5 * cfg.depth;
-    const double p = tank::shepard_pressure(system, V2(0.5 * cfg.width, z));
-    const double p_theory = tank::hydrostatic_pressure(cfg, surface, z);
-    INFO("p_sph = " << p << " Pa, p_theory = " << p_theory << " Pa, surface " << surface << " m");
-    CHECK(std::abs(p - p_theory) / p_theory <= 1.0 / cfg.particles_over_depth);
-    CHECK(lost == 0);
-    CHECK(surface == Approx(cfg.depth).margin(0.5 * cfg.dp()));
-    if (walls == WallModel::repulsive) {
-      // The fluid rests about dp/2 above the repulsive bed (the rest-gap strength), not launched off it.
-      const double gap = tank::lowest_fluid_height(system, cfg) / cfg.dp();
-      CHECK(gap > 0.25);
-      CHECK(gap < 0.75);
-    }
+// The kernel-gradient-corrected pressure gradient (Bonet & Lok 1999) next to a repulsive wall. Still water with a
+// hydrostatic, exactly linear pressure on a square lattice, one evaluation of the rates: a fluid particle in the first
+// column along a side wall has no neighbours beyond the wall, so the symmetric form gives it only the lattice sum
+// M_zz = 0.773 of the vertical pressure gradient (cubic spline, h = 1.3 dp: it would slide down at 0.227 g); the
+// corrected difference is exact for a linear field, so it is held up to round-off and to the nonlinearity of p / rho^2
+// in z (relative g D / c0^2 = 5e-4 here; tolerance 1e-3 g). The horizontal push onto the wall is not corrected: the
+// repulsive force balances it as before. Gravity 9.81 m/s^2, c0 = 100 m/s.
+TEST_CASE("corrected pressure gradient: full vertical support next to a repulsive side wall", "[walls][fluid]") {
+  const double dp = 0.025, g = 9.81, depth = 0.5;
+  const Resolution<double> res{dp, 1.3};
+  const bool corrected = GENERATE(false, true);
+  CAPTURE(corrected);
+  System2 system(Domain<2, double>(V2(-0.2, -0.2), V2(0.7, 0.8)), Tait<double>(1000, 100));
+  add_fluid_block(system, V2(0, 0), V2(0.5, depth), res, depth, g);
+  add_box_walls(system, V2(0, 0), V2(0.5, 0.7), res, WallModel::repulsive);
+  auto& p = system.particles();
+  for (std::size_t i = 0; i < p.size(); ++i) p.mass[i] = p.density[i] * dp * dp;  // volumes m / rho = dp^2
+  FluidParameters<2, double> f;
+  f.gravity = V2(0, -g);
+  f.walls = WallModel::repulsive;
+  f.repulsive.boundary_spacing = repulsive_wall_spacing(0.5, res);
+  f.gradient_correction = corrected ? GradientCorrection::near_repulsive_walls : GradientCorrection::none;
+  WcsphFluid<System2> fluid(f);
+  system.update_neighbors();
+  system.update_pressure();
+  fluid.compute_rates(system);
+  std::size_t checked = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const V2 x = p.position[i];
+    // first column along either side wall, more than 2h (2.6 dp) from the bed and from the free surface
+    if (p.kind[i] != Kind::fluid || x[1] < 3 * dp || x[1] > depth - 3 * dp) continue;
+    if (x[0] > dp && x[0] < 0.5 - dp) continue;
+    ++checked;
+    INFO("x = " << x.transpose() << ", a = " << p.acceleration[i].transpose());
+    if (corrected) CHECK(std::abs(p.acceleration[i][1]) < 1e-3 * g);
+    else CHECK(p.acceleration[i][1] == Approx(-(1 - 0.773) * g).margin(0.005 * g));
   }
+  CHECK(checked == 2 * 14);  // rows 3 .. 16 of both side columns
+}
+
+// Coarse hydrostatic tank, 20 particles over the 0.5 m depth, settled for 2 s like the example (22 periods 4H/c0 of
+// the gravest vertical acoustic mode, 1.7 of the gravest sloshing mode), with the example's setup: consistent
+// masses m = rho(z) dp^2 and, for repulsive walls, the corrected pressure gradient next to the walls.
+//   Dynamic walls: the issue's 2 % (measured +1.1 %; with uniform masses m = rho0 dp^2 the SPH volumes do not fit the
+//   lattice and the error is +3.0 %).
+//   Repulsive walls: 3 % at this resolution (measured +2.5 %, the probe's spread over the last 0.5 s is +-0.5 %;
+//   +1.1 % at N = 40 and +1.4 % at N = 60, docs/walls.md; +6.6 % without the correction). The fluid must be nearly
+//   still: max speed below 0.15 m/s, a third of the 0.3-0.45 m/s jet down the side walls that the uncorrected
+//   pressure gradient drives (measured 0.075 m/s), and it rests about dp/2 above the bed (rest-gap strength).
+namespace {
+void check_coarse_tank(WallModel walls, double tolerance) {
+  tank::TankConfig cfg;
+  cfg.particles_over_depth = 20;
+  cfg.walls = walls;
+  cfg.depth_scaling = walls == WallModel::repulsive;
+  auto system = tank::make_tank(cfg);
+  tank::TankSimulation sim(system, tank::fluid_parameters(cfg));
+  std::size_t lost = 0;
+  sim.run(2.0, [&](tank::TankSimulation&) { lost = std::max(lost, tank::particles_outside(system, cfg)); });
+  const double surface = tank::free_surface_height(system, cfg);
+  const double z = 0.5 * cfg.depth;
+  const double p = tank::shepard_pressure(system, V2(0.5 * cfg.width, z));
+  const double p_theory = tank::hydrostatic_pressure(cfg, surface, z);
+  INFO("p_sph = " << p << " Pa, p_theory = " << p_theory << " Pa, surface " << surface << " m");
+  CHECK(std::abs(p - p_theory) / p_theory <= tolerance);
+  CHECK(lost == 0);
+  CHECK(surface == Approx(cfg.depth).margin(0.5 * cfg.dp()));
+  if (walls == WallModel::repulsive) {
+    CHECK(tank::max_fluid_speed(system) < 0.15);
+    const double gap = tank::lowest_fluid_height(system, cfg) / cfg.dp();
+    CHECK(gap > 0.25);
+    CHECK(gap < 0.75);
+  }
+}
+}  // namespace
+
+TEST_CASE("hydrostatic tank, coarse, dynamic walls: hydrostatic mid-depth pressure, no particle lost",
+          "[walls][tank]") {
+  check_coarse_tank(WallModel::dynamic, 0.02);
+}
+
+TEST_CASE("hydrostatic tank, coarse, repulsive walls: hydrostatic mid-depth pressure, still, no particle lost",
+          "[walls][tank]") {
+  check_coarse_tank(WallModel::repulsive, 0.03);
 }

@@ -12,6 +12,15 @@
 //                   rho_ab^H = rho0 g.x_ab / c0^2 of Fourtakas et al. 2019, Comput. Fluids 190:346, linearised;
 //                   fluid-fluid pairs only)
 //   XSPH           dx_a/dt = v_a + eps sum_b (m_b / rho_ab) (v_b - v_a) W_ab             (Monaghan 1989)
+//   corrected pressure gradient (optional, FluidParameters::gradient_correction): for the selected fluid
+//   particles a the momentum sum is split into the pressure-difference part and the zeroth-order part,
+//     dv_a/dt = -sum_b m_b [(P_b - P_a) L_a + 2 P_a I] grad - sum_b m_b Pi_ab grad + g,   P = p / rho^2,
+//     L_a = (sum_b V_b (x_b - x_a) (x) grad_a W_ab)^-1     (Bonet & Lok 1999, Comput. Methods Appl. Mech. Eng.
+//                                                           180:97, eq. 43: kernel-gradient correction)
+//   With L_a the difference part is exact for a linear field on any particle set, also where the kernel is cut
+//   by a repulsive wall or the set is disordered; the zeroth-order part 2 P_a sum_b m_b grad is the symmetric
+//   form's own (on a full, ordered support it vanishes; next to a wall it presses the fluid onto the wall, the
+//   push the repulsive force balances). L_a = I gives the symmetric form back.
 // Walls:
 //   dynamic boundary particles (Crespo, Gomez-Gesteira & Dalrymple 2007, CMC 5:173; the SPHysics default):
 //     wall particles obey the continuity equation with their fluid neighbours and enter the fluid's
@@ -30,6 +39,8 @@
 #include <sphfsi/core/types.hpp>
 #include <sphfsi/kernel/concepts.hpp>
 
+#include <Eigen/LU>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -43,6 +54,13 @@ enum class WallModel {
   repulsive,  ///< Monaghan-Kos repulsive force
 };
 
+/// Which fluid particles get the kernel-gradient-corrected pressure gradient (Bonet & Lok 1999; see the header).
+enum class GradientCorrection {
+  none,                  ///< Monaghan's symmetric form everywhere (momentum conserved pair by pair)
+  near_repulsive_walls,  ///< fluid particles with a repulsive wall particle within their support (cut kernels)
+  everywhere,            ///< every fluid particle
+};
+
 template <int Dim, Real T>
 struct FluidParameters {
   Vec<Dim, T> gravity = standard_gravity<Dim, T>();  ///< m/s^2
@@ -52,6 +70,8 @@ struct FluidParameters {
   T kinematic_viscosity{T(0)};                       ///< laminar viscosity nu, m^2/s (0: none)
   WallModel walls{WallModel::dynamic};
   RepulsiveForceParameters<T> repulsive{};  ///< used when walls == repulsive
+  /// Kernel-gradient correction of the pressure gradient (none: the symmetric, momentum-conserving form).
+  GradientCorrection gradient_correction{GradientCorrection::none};
   /// Fluid pressure floor, Pa (-inf: none). 0 stops spray clusters from collapsing under negative pressure
   /// (tensile instability, Swegle et al. 1995): water in a thin jet cannot sustain tension.
   T minimum_pressure{-std::numeric_limits<T>::infinity()};
@@ -108,6 +128,7 @@ class WcsphFluid {
       pressure_term_[a] = p.pressure[a] / (p.density[a] * p.density[a]);  // p / rho^2, Pa m^6/kg^2
       volume_[a] = p.mass[a] / p.density[a];                              // m^3 (m^2 in 2D)
     });
+    if (params_.gradient_correction != GradientCorrection::none) update_gradient_correction(system);
     // A few slot ranges per thread, handed out dynamically: wall particles cost less than fluid ones, and on a
     // shared machine a thread may be descheduled for a while.
     const std::size_t threads = static_cast<std::size_t>(std::max(1, thread_count()));
@@ -151,6 +172,72 @@ class WcsphFluid {
   }
 
  private:
+  // Smallest det(M_a) for which L_a = M_a^-1 is used (a full support has M_a = I, det 1; a particle at a flat
+  // free surface about 0.5): below it (a particle with few neighbours, a splash) M_a is too close to singular for
+  // its inverse to be trusted, and L_a = I.
+  static constexpr T min_moment_determinant = T(0.1);
+
+  // Largest h |sum_b V_b grad_a W_ab| (the part not along a repulsive wall's normal) of a corrected particle. The
+  // vector vanishes on a full support and points into the fluid where the support is cut (Marrone et al. 2010,
+  // J. Comput. Phys. 229:3652, use it as the free-surface normal): h |.| is 0.59 and 0.07 for the first and second
+  // row under a flat free surface (square lattice, cubic spline, h = 1.3 dp) and 0 from the third row down. So
+  // particles within two rows of a free surface keep the symmetric form: its missing support above them is what
+  // holds them to the surface (measured: corrected surface particles fly off within 0.2 s), and a corrected
+  // gradient is blind to it.
+  static constexpr T max_free_surface_moment = T(0.05);
+
+  // L_a for the fluid particles selected by gradient_correction (corrected_[a] = 1), from the moment matrix
+  //   M_a = sum_b V_b (x_b - x_a) (x) grad_a W_ab = -sum_b V_b (dW/dr / r) dx dx^T   (dx = x_a - x_b)
+  // over the neighbours that enter a's pressure sum (fluid, and dynamic wall particles). On a full lattice support
+  // M_a = I to the kernel's discretisation error.
+  void update_gradient_correction(const System& system) {
+    const auto& p = system.particles();
+    const std::size_t n = p.size();
+    correction_.resize(n);
+    const bool dynamic_walls = params_.walls == WallModel::dynamic;
+    const bool everywhere = params_.gradient_correction == GradientCorrection::everywhere;
+    // Candidates: every fluid particle, or those within the support of a repulsive wall particle (found from the
+    // wall side: walls are few).
+    corrected_.assign(n, 0);
+    if (everywhere) {
+      for (std::size_t a = 0; a < n; ++a) corrected_[a] = p.kind[a] == Kind::fluid;
+    } else if (!dynamic_walls) {
+      for (std::size_t w = 0; w < n; ++w) {
+        if (p.kind[w] != Kind::wall) continue;
+        system.for_each_neighbor(w, [&](std::size_t b, const Vector&, T, T) {
+          if (p.kind[b] == Kind::fluid) corrected_[b] = 1;
+        });
+      }
+    }
+    const auto& kernel = system.kernel();
+    parallel_for(n, [&](std::size_t a) {
+      if (!corrected_[a]) return;
+      corrected_[a] = 0;  // until L_a is known
+      Mat<Dim, T> moment = Mat<Dim, T>::Zero();
+      Vector gamma = Vector::Zero();        // sum_b V_b grad_a W_ab, 1/m
+      Vector wall_normal = Vector::Zero();  // sum of the normals of the repulsive wall particles within the support
+      system.for_each_neighbor(a, [&](std::size_t b, const Vector& dx, T r, T h) {
+        const Kind kb = p.kind[b];
+        if (kb == Kind::solid) return;
+        if (kb == Kind::wall && !dynamic_walls) {
+          wall_normal += p.normal[b];
+          return;
+        }
+        const T grad_factor = r > T(0) ? kernel.derivative(r, h) / r : T(0);
+        moment.noalias() -= (volume_[b] * grad_factor) * (dx * dx.transpose());
+        gamma += (volume_[b] * grad_factor) * dx;
+      });
+      if (!(moment.determinant() >= min_moment_determinant)) return;
+      // Free-surface test: the part of gamma not along the wall normal comes from a support cut by something else
+      // than the wall, a free surface; there the correction would remove the surface's restoring force.
+      const T wall_norm = wall_normal.norm();
+      if (wall_norm > T(0)) gamma -= gamma.dot(wall_normal) / (wall_norm * wall_norm) * wall_normal;
+      if (gamma.norm() * p.smoothing_length[a] > max_free_surface_moment) return;
+      correction_[a] = moment.inverse();
+      corrected_[a] = 1;
+    });
+  }
+
   // What the pairs of one slot range add to slots beyond it (other ranges): slot begin + k at index k.
   struct Spill {
     std::size_t begin = 0;
@@ -225,6 +312,7 @@ class WcsphFluid {
     const T eps_xsph = params_.xsph;
     const T nu = params_.kinematic_viscosity;
     const bool dynamic_walls = params_.walls == WallModel::dynamic;
+    const bool corrected = params_.gradient_correction != GradientCorrection::none;
     const int up = params_.repulsive.vertical_axis;
     const T water_level = params_.repulsive.water_level;
     const Kind* kind = p.kind.data();
@@ -267,16 +355,21 @@ class WcsphFluid {
       T drho_b = ma * continuity;
       const T rho_b = rho[b];
       const T pi_ab = vr < T(0) ? -alpha * (ca + c[b]) * mu / (rho_a + rho_b) : T(0);
-      const T force = pa + pressure_term[b] + pi_ab;
+      const T pb = pressure_term[b];
+      const T force = pa + pb + pi_ab;
       const T laminar =
           nu > T(0) ? nu * (rho_a + rho_b) / (rho_a * rho_b) * grad_factor * r2 * inverse_distance2 : T(0);
       if (fluid_a) {
-        acc -= (mass[b] * force) * grad;
+        if (corrected && corrected_[a])  // -m_b [(P_b - P_a) L_a + (2 P_a + Pi_ab) I] grad
+          acc -= mass[b] * ((pb - pa) * (correction_[a] * grad) + (T(2) * pa + pi_ab) * grad);
+        else acc -= (mass[b] * force) * grad;
         if (nu > T(0)) acc += (mass[b] * laminar) * vab;
         mu_max = std::max(mu_max, std::abs(mu));
       }
       if (fluid_b) {
-        Vector acc_b = (ma * force) * grad;
+        Vector acc_b = corrected && corrected_[b]  // grad_b W = -grad
+                           ? Vector(ma * ((pa - pb) * (correction_[b] * grad) + (T(2) * pb + pi_ab) * grad))
+                           : Vector((ma * force) * grad);
         if (nu > T(0)) acc_b -= (ma * laminar) * vab;
         partner.add_acceleration(b, acc_b);
         partner.raise_signal_speed(b, std::abs(mu));
@@ -305,9 +398,11 @@ class WcsphFluid {
 
   FluidParameters<Dim, T> params_;
   std::vector<T> signal_speed_;
-  std::vector<T> pressure_term_;  // p / rho^2 per slot, Pa m^6/kg^2
-  std::vector<T> volume_;         // m / rho per slot
-  std::vector<Spill> spills_;     // one per slot range
+  std::vector<T> pressure_term_;          // p / rho^2 per slot, Pa m^6/kg^2
+  std::vector<T> volume_;                 // m / rho per slot
+  std::vector<Spill> spills_;             // one per slot range
+  std::vector<Mat<Dim, T>> correction_;   // L_a per slot (valid where corrected_[a])
+  std::vector<unsigned char> corrected_;  // 1: slot a uses the corrected pressure gradient
 };
 
 }  // namespace sphfsi
