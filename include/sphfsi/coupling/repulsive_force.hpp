@@ -5,6 +5,13 @@
 // depth/velocity factor eps (boundary/repulsive_force.hpp). The fluid particle f receives the acceleration
 // a_f = n R P eps (17); the solid particle s receives the reaction -m_f a_f / m_s, so the pair conserves momentum to
 // round-off. The paper retains this approach for the Antoci gate and the Posidonia meadow.
+//
+// Thin structures (a solid with `static constexpr bool thin_structure = true`, e.g. solid/elastic_rod.hpp: a blade
+// as one line of nodes) have no interior and no colour-gradient surface: every node is a boundary particle, with
+// the unit normal n_s the model publishes in p.normal, and it pushes on both faces: a fluid particle at
+// dx = x_f - x_s sees the face n = sign(dx . n_s) n_s, i.e. it is pushed back to the side it is on. The repulsion
+// grows like 1 / sqrt(q) as the fluid particle approaches the blade, so it cannot be crossed in one step at the
+// fluid's CFL (tested: tests/unit/test_couplings.cpp).
 #pragma once
 
 #include <sphfsi/boundary/repulsive_force.hpp>
@@ -37,8 +44,10 @@ struct RepulsiveForce {
     constexpr int up = System::dimension - 1;
     auto& p = system.particles();
     const auto& ids = solid.particle_ids();
+    constexpr bool thin = requires { requires Solid::thin_structure; };
     std::vector<char> surface;
-    update_solid_surface(system, ids, solid.body(), surface);
+    if constexpr (thin) surface.assign(ids.size(), 1);  // every node, normal published by the model
+    else update_solid_surface(system, ids, solid.body(), surface);
     RepulsiveForceParameters<T> params;
     params.boundary_spacing = range_factor * solid.reference_spacing();
     params.water_level = water_level;
@@ -49,9 +58,12 @@ struct RepulsiveForce {
     for (std::size_t k = 0; k < ids.size(); ++k) {
       if (!surface[k]) continue;
       const std::size_t s = p.slot_of_id(ids[k]);
-      const Vector n = p.normal[s];
+      const Vector n_s = p.normal[s];
       system.for_each_neighbor(s, [&](std::size_t f, const Vector& dx_sf, T, T h) {
         if (p.kind[f] != Kind::fluid) return;
+        Vector n = n_s;
+        if constexpr (thin)
+          if (dx_sf.dot(n_s) > T(0)) n = -n_s;  // dx_sf = x_s - x_f: the fluid is on the -n_s face
         const Vector a_f = repulsive_force<System::dimension, T>(-dx_sf, p.velocity[f] - p.velocity[s], n, h, c0,
                                                                  p.position[f][up] - water_level, params);
         p.acceleration[f] += a_f;

@@ -133,6 +133,9 @@ class ElasticRod {
  public:
   static_assert(System::dimension == 2, "ElasticRod is a planar rod: use a 2D ParticleSystem");
   static constexpr int Dim = 2;
+  /// A line of nodes with no interior: couplings take the normal each node publishes and push on both faces
+  /// (coupling/repulsive_force.hpp) instead of finding a surface by the colour gradient.
+  static constexpr bool thin_structure = true;
   using T = typename System::scalar_type;
   using Vector = Vec<2, T>;
   using Matrix = Mat<2, T>;
