@@ -51,6 +51,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <string>
 #include <utility>
@@ -220,6 +221,16 @@ class ElasticRod {
       if (pred(X_[k])) held_[k] = 1;
     return held_count();
   }
+  /// Moves the held nodes rigidly: each sits at its reference position plus displacement(t) with velocity
+  /// velocity(t), the clamped tangents unchanged (a blade towed along the bed through still water). Without it
+  /// held nodes stay at rest.
+  void set_clamp_motion(std::function<Vector(T)> displacement, std::function<Vector(T)> velocity) {
+    if (!displacement || !velocity)
+      throw InputError("ElasticRod::set_clamp_motion: both displacement(t) and velocity(t) must be given");
+    clamp_displacement_ = std::move(displacement);
+    clamp_velocity_ = std::move(velocity);
+  }
+
   /// Clamps the base (node 0): position and tangent held. Returns the number of held nodes.
   std::size_t clamp_base() {
     held_[0] = 1;
@@ -252,10 +263,13 @@ class ElasticRod {
     const Vector g = body_force();
     internal_forces();
     for (std::size_t s = 0; s < n_sub; ++s) {
+      const T t_end = time + T(s + 1) * h;
+      const Vector d = clamp_displacement_ ? clamp_displacement_(t_end) : Vector::Zero();
+      const Vector u = clamp_velocity_ ? clamp_velocity_(t_end) : Vector::Zero();
       for (std::size_t k = 0; k < n; ++k) {
         if (held_[k]) {
-          x_[k] = X_[k];
-          v_[k].setZero();
+          x_[k] = X_[k] + d;
+          v_[k] = u;
           continue;
         }
         v_[k] += T(0.5) * h * (a_int_[k] + a_ext_[k] + g);
@@ -365,6 +379,16 @@ class ElasticRod {
     return e;
   }
   std::size_t sub_step_total() const noexcept { return sub_steps_; }
+  /// Total force the couplings exert on the rod (all nodes, held ones included), N per unit depth in 2D: the sum
+  /// of m_i a_i over the nodes of the force per unit mass found in the particle set after the rate evaluation.
+  Vector coupling_force(const ParticleSet<2, T>& p) const {
+    Vector f = Vector::Zero();
+    for (const std::uint32_t id : ids_) {
+      const std::size_t s = p.slot_of_id(id);
+      f += p.mass[s] * p.acceleration[s];
+    }
+    return f;
+  }
 
   // ---- checkpoint (io/checkpoint.hpp) ----
   template <class Writer>
@@ -515,6 +539,7 @@ class ElasticRod {
   std::vector<Vector> a_int_, a_ext_;              // internal and external acceleration, m/s^2
   T omega_max_{0};                                 // rad/s
   std::size_t sub_steps_{0};
+  std::function<Vector(T)> clamp_displacement_, clamp_velocity_;  // motion of the held nodes (empty: at rest)
 };
 
 }  // namespace sphfsi

@@ -1,0 +1,222 @@
+// sphfsi example: reconfiguration of a flexible blade in a steady current (Luhar & Nepf 2011, J. Fluid Mech.
+// 680; validation-cases.md sec. 6), issue 5 part 5 and issue 6 part 3.
+//
+// A blade of length l, thickness t and Young's modulus E, clamped upright at its base on the bed of a closed 2D
+// channel (depth 3 l, a lid instead of a free surface: the steady current has no surface waves to make), is towed
+// along the bed at speed U through still water (the Galilean equivalent of a current U past a fixed blade over a
+// bed moving with the current, i.e. without a bed boundary layer). The blade is one line of nodes of the
+// discrete elastic rod (solid/elastic_rod.hpp) with its real thickness and modulus, coupled to the fluid by the
+// repulsive force on both faces (coupling/repulsive_force.hpp). Once the flow is steady, the time-averaged drag F
+// of the flexible blade over that of a rigid blade of the same length in the same flow gives the effective length
+//     l_e / l = F / F_rigid,
+// compared with Luhar & Nepf's model (no buoyancy here: g = 0, B = 0)
+//     l_e / l = 1 - (1 - 0.9 Ca^(-1/3)) / (1 + 8 Ca^(-3/2)),   Ca = rho C_D U^2 l^3 / (2 E t^3 / 12)
+// with C_D = F_rigid / (rho U^2 l / 2) measured on the rigid blade (per unit width: b cancels in 2D).
+// The Cauchy number is set through E at fixed U, l, t (same Reynolds number for every case).
+//
+// Writes <output>/summary.csv (one row per case), <output>/case_<Ca>.csv (drag and tip position vs time) and
+// <output>/effective_length.png (plot.py).
+#include <sphfsi/core/particle_system.hpp>
+#include <sphfsi/coupling/coupled_body.hpp>
+#include <sphfsi/coupling/repulsive_force.hpp>
+#include <sphfsi/eos/tait.hpp>
+#include <sphfsi/integrators/simulation.hpp>
+#include <sphfsi/integrators/symplectic.hpp>
+#include <sphfsi/io/command_line.hpp>
+#include <sphfsi/io/csv.hpp>
+#include <sphfsi/io/progress.hpp>
+#include <sphfsi/kernel/wendland_c2.hpp>
+#include <sphfsi/scenes/builders.hpp>
+#include <sphfsi/solid/elastic_rod.hpp>
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <numbers>
+#include <sstream>
+#include <string>
+#include <vector>
+
+using namespace sphfsi;
+using T = double;
+using V = Vec<2, T>;
+using System = ParticleSystem<2, T, WendlandC2<2>, Tait<T>>;
+using Rod = ElasticRod<System>;
+using Blade = CoupledBody<RepulsiveForce<T>, Rod>;
+using Solver = Simulation<System, SymplecticVerlet, Blade>;
+
+struct Options {
+  T length = 0.05;         // l, m
+  T thickness = 4e-4;      // t, m (HDPE blades of Luhar & Nepf 2011: 0.4 mm)
+  T density = 950;         // rho_s, kg/m^3 (neutral buoyancy does not matter: g = 0)
+  T speed = 0.2;           // U, m/s
+  T particles_along = 15;  // l / dp
+  T nominal_drag = 2.0;    // C_D used to choose E for a target Ca (the measured one is reported)
+  T tow_lengths = 8;       // towing distance after the ramp, in blade lengths
+  T average_from = 3;      // the drag is averaged once the blade has moved this many lengths after the ramp
+  std::vector<T> cauchy{0, 1, 3, 10, 30, 100, 300, 1000};  // 0: the rigid blade
+  std::filesystem::path output = "out/blade_in_current";
+};
+
+struct CaseResult {
+  T target_ca, youngs_modulus, drag, drag_error, tip_x, tip_y, wall;
+  std::size_t steps, particles;
+};
+
+/// Luhar & Nepf (2011) effective length without buoyancy.
+T model_effective_length(T ca) {
+  return T(1) - (T(1) - T(0.9) * std::cbrt(T(1) / ca)) / (T(1) + T(8) * std::pow(ca, T(-1.5)));
+}
+
+CaseResult run_case(const Options& o, T target_ca) {
+  const T l = o.length, dp = l / o.particles_along, depth = 3 * l, U = o.speed, rho = 1000;
+  const T x0 = 2 * l, ramp = T(0.25), tow = o.tow_lengths * l;
+  const T tank = x0 + U * ramp / 2 + tow + 3 * l;
+  const T c0 = 20 * U;  // the flow around the blade's tip reaches about 2 U: c0 >= 10 x that
+  const Resolution<T> res{dp, T(1.3)};
+  System system(Domain<2, T>(V(-4 * dp, -4 * dp), V(tank + 4 * dp, depth + 4 * dp)), Tait<T>(rho, c0));
+  add_fluid_block(system, V(0, 0), V(tank, depth), res, depth, T(0));
+  add_box_walls(system, V(0, 0), V(tank, depth), res, WallModel::dynamic);
+  for_each_lattice_point<2, T>(V(-3 * dp, depth), V(tank + 3 * dp, depth + 3 * dp), dp, [&](const V& x) {
+    system.particles().add(Kind::wall, x, V::Zero(), rho, rho * dp * dp, res.h(), 0);  // the lid
+  });
+  // The blade on a lattice line (fluid columns at dp/2 on either side), nodes at dp/2.
+  const int nodes = static_cast<int>(std::lround(2 * o.particles_along)) + 1;
+  ElasticMaterial<T> material;
+  material.density = o.density;
+  material.poisson_ratio = T(0.4);
+  const T second_moment = o.thickness * o.thickness * o.thickness / 12;  // per unit width, m^3
+  material.youngs_modulus =
+      target_ca > 0 ? rho * o.nominal_drag * U * U * l * l * l / (2 * target_ca * second_moment) : T(1e9);
+  const RodSection<T> section{.thickness = o.thickness, .width = T(0.01)};
+  add_elastic_rod(system, V(x0, 0), V(0, 1), l, nodes, material, section, res.h(), 1);
+  typename Rod::Parameters params;
+  params.section = section;
+  params.gravity = V::Zero();
+  Rod rod(system, 1, material, params);
+  if (target_ca > 0) rod.clamp_base();
+  else rod.clamp_where([](const V&) { return true; });  // the rigid reference blade
+  // Towing: velocity U (1 - cos(pi t / ramp)) / 2 during the ramp, U after it.
+  const T pi = std::numbers::pi_v<T>;
+  rod.set_clamp_motion(
+      [=](T t) {
+        return V(t < ramp ? U * (t / 2 - ramp / (2 * pi) * std::sin(pi * t / ramp)) : U * (t - ramp / 2), 0);
+      },
+      [=](T t) { return V(t < ramp ? U * (1 - std::cos(pi * t / ramp)) / 2 : U, 0); });
+  FluidParameters<2, T> fluid;
+  fluid.gravity = V::Zero();
+  fluid.artificial_viscosity = T(0.02);
+  RepulsiveForce<T> coupling;  // eq. 19 with k = 0.01: no hydrostatic load to balance here
+  Solver sim(system, fluid, {}, Blade(coupling, std::move(rod)));
+  sim.set_expected_flow_speed(2 * U);
+
+  const std::string label = target_ca > 0 ? fmt::format("{:g}", target_ca) : "rigid";
+  io::CsvWriter csv(o.output / fmt::format("case_{}.csv", label), {"t", "drag", "tip_dx", "tip_dy"});
+  const T t_end = ramp + tow / U, t_avg = ramp + o.average_from * l / U;
+  const auto& ids = sim.model<0>().solid().particle_ids();
+  std::vector<T> samples;
+  T tip_x = 0, tip_y = 0;
+  std::size_t tip_n = 0;
+  io::ProgressReporter progress(t_end);
+  const auto start = std::chrono::steady_clock::now();
+  T next_sample = 0;
+  sim.run(t_end, [&](Solver& s) {
+    progress(s);
+    if (s.time() < next_sample) return;
+    next_sample += T(0.005);
+    const auto& p = s.system().particles();
+    const T drag = -s.template model<0>().solid().coupling_force(p)[0];
+    const V base = p.position[p.slot_of_id(ids.front())], tip = p.position[p.slot_of_id(ids.back())];
+    csv.write_row({s.time(), drag, tip[0] - base[0], tip[1] - base[1]});
+    if (s.time() >= t_avg) {
+      samples.push_back(drag);
+      tip_x += tip[0] - base[0];
+      tip_y += tip[1] - base[1];
+      ++tip_n;
+    }
+  });
+  progress.finish(sim);
+  // Mean drag and its standard error from 8 blocks (the samples are correlated within a block).
+  T mean = 0;
+  for (T f : samples) mean += f;
+  mean /= T(samples.size());
+  const std::size_t blocks = 8, per = samples.size() / blocks;
+  T var = 0;
+  for (std::size_t b = 0; b < blocks; ++b) {
+    T m = 0;
+    for (std::size_t k = b * per; k < (b + 1) * per; ++k) m += samples[k];
+    m /= T(per);
+    var += (m - mean) * (m - mean);
+  }
+  const T se = std::sqrt(var / T(blocks * (blocks - 1)));
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return {target_ca, material.youngs_modulus, mean,         se, tip_x / T(tip_n), tip_y / T(tip_n),
+          wall,      sim.step_count(),        system.size()};
+}
+
+int main(int argc, char** argv) try {
+  io::CommandLine cli(argc, argv,
+                      "blade_in_current: a flexible blade towed through still water (a steady current); effective "
+                      "length l_e / l = F / F_rigid against Luhar & Nepf (2011).");
+  Options o;
+  o.speed = cli.get_number("speed", o.speed, "towing speed U, m/s");
+  o.length = cli.get_number("length", o.length, "blade length l, m");
+  o.thickness = cli.get_number("thickness", o.thickness, "blade thickness t, m");
+  o.particles_along = cli.get_number("resolution", o.particles_along, "fluid particles along the blade, l / dp");
+  o.tow_lengths = cli.get_number("tow-lengths", o.tow_lengths, "towing distance after the ramp, blade lengths");
+  o.average_from = cli.get_number("average-from", o.average_from, "start of the drag average, blade lengths");
+  const std::string list = cli.get("cauchy", "0,1,3,10,30,100,300,1000", "target Cauchy numbers (0: rigid blade)");
+  o.output = cli.get("output", o.output.string(), "output folder");
+  if (!cli.finish()) return 0;
+  require_positive("--speed (m/s)", o.speed);
+  require_positive("--length (m)", o.length);
+  require_positive("--thickness (m)", o.thickness);
+  require_in_range("--resolution (l / dp)", o.particles_along, T(5), T(200));
+  require_in_range("--average-from (blade lengths)", o.average_from, T(0), o.tow_lengths - T(1));
+  o.cauchy.clear();
+  std::stringstream ss(list);
+  for (std::string item; std::getline(ss, item, ',');) o.cauchy.push_back(std::stod(item));
+  if (o.cauchy.empty() || o.cauchy.front() != 0)
+    throw InputError("--cauchy must start with 0 (the rigid blade that every l_e / l is measured against)");
+  std::filesystem::create_directories(o.output);
+
+  std::vector<CaseResult> results;
+  for (const T ca : o.cauchy) {
+    fmt::print("--- {}\n", ca > 0 ? fmt::format("Ca = {:g}", ca) : std::string("rigid blade"));
+    results.push_back(run_case(o, ca));
+  }
+  const T rigid = results.front().drag, rho = 1000;
+  const T drag_coefficient = rigid / (T(0.5) * rho * o.speed * o.speed * o.length);
+  fmt::print("rigid blade: F = {:.4g} +- {:.2g} N/m, C_D = {:.3f} (blockage l / depth = 1/3 included)\n", rigid,
+             results.front().drag_error, drag_coefficient);
+  io::CsvWriter summary(o.output / "summary.csv",
+                        {"target_ca", "ca", "youngs_modulus", "drag", "drag_error", "effective_length",
+                         "effective_length_error", "model", "tip_dx", "tip_dy", "steps", "particles", "wall_s"});
+  fmt::print("| Ca | E (Pa) | F (N/m) | l_e/l SPH | l_e/l model | deviation | tip (dx, dy)/l | wall (s) |\n");
+  fmt::print("|---|---|---|---|---|---|---|---|\n");
+  T worst = 0;
+  for (const auto& r : results) {
+    const T ca = r.target_ca > 0 ? r.target_ca * drag_coefficient / o.nominal_drag : 0;
+    const T le = r.drag / rigid;
+    const T le_err = le * std::hypot(r.drag_error / r.drag, results.front().drag_error / rigid);
+    const T model = ca > 0 ? model_effective_length(ca) : T(1);
+    if (ca > 0) worst = std::max(worst, std::abs(le - model) / model);
+    summary.write_row({r.target_ca, ca, r.youngs_modulus, r.drag, r.drag_error, le, le_err, model, r.tip_x, r.tip_y,
+                       T(r.steps), T(r.particles), r.wall});
+    fmt::print("| {} | {:.3g} | {:.4g} | {:.3f} +- {:.3f} | {:.3f} | {:+.1f} % | ({:.2f}, {:.2f}) | {:.0f} |\n",
+               ca > 0 ? fmt::format("{:.3g}", ca) : std::string("rigid"), r.youngs_modulus, r.drag, le, le_err, model,
+               ca > 0 ? 100 * (le - model) / model : 0.0, r.tip_x / o.length, r.tip_y / o.length, r.wall);
+  }
+  fmt::print("largest deviation from Luhar & Nepf: {:.1f} % ({} particles, dp = {:.3g} m)\n", 100 * worst,
+             results.front().particles, o.length / o.particles_along);
+  const std::string plot =
+      fmt::format("/usr/bin/python3 {}/examples/blade_in_current/plot.py {}", SPHFSI_SOURCE_DIR, o.output.string());
+  if (std::system(plot.c_str()) != 0) fmt::print("(plot skipped: /usr/bin/python3 with matplotlib not available)\n");
+  return 0;
+} catch (const std::exception& e) {
+  fmt::print(stderr, "blade_in_current: error: {}\n", e.what());
+  return 1;
+}
