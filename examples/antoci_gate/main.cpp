@@ -13,6 +13,7 @@
 #include <sphfsi/eos/tait.hpp>
 #include <sphfsi/integrators/simulation.hpp>
 #include <sphfsi/integrators/symplectic.hpp>
+#include <sphfsi/io/checkpoint.hpp>
 #include <sphfsi/io/command_line.hpp>
 #include <sphfsi/io/csv.hpp>
 #include <sphfsi/io/progress.hpp>
@@ -41,6 +42,8 @@ struct Options {
   std::filesystem::path output;
   std::string data_dir;
   Scalar max_rms_dx = 1, max_rms_dy = 1;  // m; the exit status is non-zero above these
+  Scalar checkpoint_interval = 0;         // s of simulated time between checkpoints (0: none)
+  bool resume = false;                    // continue from <output>/antoci_gate.chk
 };
 
 // The gate's solid model with gravity and a stretch limit (a gate stretched 3x has broken: stop with a diagnosis).
@@ -76,18 +79,46 @@ int run(const Options& opt, const Coupling& coupling) {
       system.particles().count(Kind::solid), scene.fluid_sound_speed, scene.solid_material().p_wave_speed());
 
   std::filesystem::create_directories(opt.output);
-  io::CsvWriter tip_csv(opt.output / "gate_tip.csv", {"t", "dx", "dy", "max_stretch", "fluid_inside_gate"});
-  io::VtkSeriesWriter vtk(opt.output, "antoci_gate");
-  const Vec<2, Scalar> tip0 = scenes::gate_tip_position(system.particles(), ids.tip);
+  const Vec<2, Scalar> tip0 = scenes::gate_tip_position(system.particles(), ids.tip);  // built scene: the rest state
+  // Checkpoint / restart (io/checkpoint.hpp): the whole state, solid included, in one file replaced atomically;
+  // a resumed run continues bit-identically and keeps the tip record written up to the checkpoint.
+  const std::filesystem::path checkpoint = opt.output / "antoci_gate.chk";
   scenes::GateTipRecord<Scalar> record;
-  Scalar next_sample = 0, next_snapshot = 0, max_stretch = 1;
+  std::vector<std::vector<Scalar>> earlier_rows;
+  Scalar max_stretch = 1;
   std::size_t max_inside = 0;
+  if (opt.resume) {
+    io::read_checkpoint(checkpoint, sim);
+    const io::CsvTable old = io::read_csv(opt.output / "gate_tip.csv");
+    const auto t = old.column("t"), dx = old.column("dx"), dy = old.column("dy"), st = old.column("max_stretch"),
+               in = old.column("fluid_inside_gate");
+    for (std::size_t k = 0; k < t.size() && t[k] <= sim.time() + 1e-12; ++k) {
+      earlier_rows.push_back({t[k], dx[k], dy[k], st[k], in[k]});
+      record.add(t[k], dx[k], dy[k]);
+      max_stretch = std::max(max_stretch, st[k]);
+      max_inside = std::max(max_inside, static_cast<std::size_t>(in[k]));
+    }
+    fmt::print("resumed from {} at t = {:.4f} s, step {}\n", checkpoint.string(), sim.time(), sim.step_count());
+  }
+  io::CsvWriter tip_csv(opt.output / "gate_tip.csv", {"t", "dx", "dy", "max_stretch", "fluid_inside_gate"});
+  for (const auto& row : earlier_rows) tip_csv.write_row(row);
+  // A resumed run writes its snapshots as a series of its own (the first run's .pvd stays as it was).
+  io::VtkSeriesWriter vtk(
+      opt.output, opt.resume ? fmt::format("antoci_gate_resumed_at_{:.4f}s", sim.time()) : std::string("antoci_gate"));
+  const Scalar sample_interval = 0.002;
+  std::size_t samples = earlier_rows.size();  // sample k is taken at the first step with t >= k sample_interval
+  Scalar next_sample = sample_interval * Scalar(samples);
+  Scalar next_snapshot = sim.time(), next_checkpoint = sim.time() + opt.checkpoint_interval;
   std::string failure;
   const auto start = std::chrono::steady_clock::now();
   io::ProgressReporter progress(opt.end_time);  // one line in place on a terminal, periodic lines in logs
   try {
     sim.run(opt.end_time, [&](auto& s) {
       progress(s);
+      if (opt.checkpoint_interval > 0 && s.time() + 1e-12 >= next_checkpoint) {
+        io::write_checkpoint(checkpoint, s);  // only states that passed the step's checks get here
+        next_checkpoint += opt.checkpoint_interval;
+      }
       if (s.time() + 1e-12 < next_sample) return;
       const auto& p = s.system().particles();
       const Vec<2, Scalar> d = scenes::gate_tip_position(p, ids.tip) - tip0;
@@ -97,7 +128,7 @@ int run(const Options& opt, const Coupling& coupling) {
       max_inside = std::max(max_inside, inside);
       record.add(s.time(), d[0], d[1]);
       tip_csv.write_row({s.time(), d[0], d[1], stretch, Scalar(inside)});
-      next_sample += 0.002;
+      next_sample = sample_interval * Scalar(++samples);
       if (s.time() + 1e-12 >= next_snapshot) {
         vtk.write(p, s.time());
         next_snapshot += opt.snapshot_interval;
@@ -153,6 +184,10 @@ int main(int argc, char** argv) try {
   opt.end_time = cli.get_number("end-time", 0.4, "simulated time, s");
   opt.snapshot_interval = cli.get_number("snapshot-interval", 0.02, "time between VTK snapshots, s");
   opt.output = cli.get("output", "out/antoci_gate", "output folder");
+  opt.checkpoint_interval = cli.get_number(
+      "checkpoint-interval", 0, "write <output>/antoci_gate.chk every this many simulated seconds (0: never)");
+  opt.resume =
+      cli.get("resume", "no", "yes: continue from <output>/antoci_gate.chk (same flags as the first run)") == "yes";
   opt.data_dir = cli.get("data", SPHFSI_SHARED_DATA_DIR, "folder with antoci2007_gate_tip_*.csv");
   opt.max_rms_dx =
       1e-3 * cli.get_number("max-rms-dx", 1000, "exit with status 2 if the RMS error in dx exceeds this, mm");
@@ -160,6 +195,7 @@ int main(int argc, char** argv) try {
       1e-3 * cli.get_number("max-rms-dy", 1000, "exit with status 2 if the RMS error in dy exceeds this, mm");
   if (!cli.finish()) return 0;
   require_positive("--end-time (s)", opt.end_time);
+  require_non_negative("--checkpoint-interval (s)", opt.checkpoint_interval);
   if (solid != "tl" && solid != "ul")
     throw InputError(fmt::format("--solid = '{}' is invalid: valid values are tl, ul", solid));
   // eps(z) of eq. 22 scales the repulsion with the depth below the still-water level, like hydrostatic pressure.
