@@ -249,13 +249,44 @@ TEST_CASE("Robustness: every bad input of the public API is rejected, naming the
     io::GuardedRunOptions{.checkpoint = "a.chk", .checkpoint_interval = 1, .snapshot_interval = -1}.validate();
   });
   bad.expect("cannot be opened", [] { io::read_checkpoint_info(output_dir() / "does-not-exist.chk"); });
+  // Solid materials and models, couplings, thin blades, scenes.
+  const auto material = [](T rho, T e, T nu) {
+    return ElasticMaterial<T>{.density = rho, .youngs_modulus = e, .poisson_ratio = nu};
+  };
+  for (T v : {T(0), T(-1), nan_value}) {
+    bad.expect("ElasticMaterial::density", [=] { material(v, 1e6, 0.3).validate(); });
+    bad.expect("ElasticMaterial::youngs_modulus", [=] { material(1000, v, 0.3).validate(); });
+  }
+  for (T nu : {T(0.5), T(-1), T(0.7), nan_value})
+    bad.expect("ElasticMaterial::poisson_ratio", [=] { material(1000, 1e6, nu).validate(); });
+  bad.expect("TotalLagrangianParameters::cfl", [] { TotalLagrangianParameters<2, T>{.cfl = 0}.validate(); });
+  bad.expect("TotalLagrangianParameters::hourglass",
+             [] { TotalLagrangianParameters<2, T>{.hourglass = -1}.validate(); });
+  bad.expect("TotalLagrangianParameters::stretch_limit",
+             [] { TotalLagrangianParameters<2, T>{.stretch_limit = 0.5}.validate(); });
+  bad.expect("UpdatedLagrangianParameters::artificial_stress",
+             [] { UpdatedLagrangianParameters<2, T>{.artificial_stress = 2}.validate(); });
+  bad.expect("RepulsiveForce::range_factor", [] { RepulsiveForce<T>{.range_factor = 10}.validate(); });
+  bad.expect("RepulsiveForce::strength", [] { RepulsiveForce<T>{.strength = 0}.validate(); });
+  bad.expect("RodSection::thickness", [] { RodSection<T>{.thickness = 0}.validate(); });
+  bad.expect("RodSection::width", [] { RodSection<T>{.thickness = 1e-4, .width = -1}.validate(); });
+  bad.expect("ElasticRodParameters::cfl", [] { ElasticRodParameters<T>{.cfl = 2}.validate(); });
+  bad.expect("add_elastic_rod: node_count", [=] {
+    System2 s(tank_domain, water);
+    add_elastic_rod(s, V2(0.1, 0), V2(0, 1), 0.1, 2, material(1000, 1e6, 0.3), RodSection<T>{}, 0.01, 1);
+  });
+  bad.expect("AntociGate::solid_refinement", [] { scenes::AntociGate<T>{.solid_refinement = 3}.validate(); });
+  bad.expect("Simulation::set_expected_flow_speed", [] {
+    System2 s(tank_domain, water);
+    Simulation<System2, SymplecticVerlet>(s, FluidParameters<2, T>{}).set_expected_flow_speed(0);
+  });
 
   std::printf("[robustness] bad inputs tried: %d, rejected naming the parameter: %d\n", bad.tried, bad.rejected);
   INFO("bad inputs tried: " << bad.tried << ", rejected with the parameter named: " << bad.rejected);
   INFO(bad.report());
   CHECK(bad.failures.empty());
   CHECK(bad.rejected == bad.tried);
-  CHECK(bad.tried == 89);  // keeps the list from silently shrinking
+  CHECK(bad.tried == 89 + 22);  // keeps the list from silently shrinking
 }
 
 // ---------------------------------------------------------------------------------------------------------------
