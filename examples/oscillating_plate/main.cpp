@@ -49,10 +49,12 @@ struct Options {
   T hourglass = 0.1;               // TLSPH alpha_hg
   T h_ratio = 1.3;                 // h / dp
   T cfl = 0.3;                     // solid CFL number
-  bool fixed_clamp = false;        // TLSPH: hold the wall part at rest instead of the reflected clamp
-  bool linear_correction = false;  // TLSPH: Bonet-Lok gradient (exact for linear fields only) everywhere
-  bool uncorrected = false;        // ULSPH: original GMS 2001 velocity gradient (no kernel-gradient correction)
+  bool fixed_clamp = false;        // hold the wall part at rest instead of the reflected clamp
+  bool linear_correction = false;  // Bonet-Lok gradient (exact for linear fields only) everywhere
+  bool gms = false;                // ULSPH: the original Gray-Monaghan-Swift sums (no correction)
   T viscosity = -1;                // artificial viscosity alpha (default 0 TL, 0.5 UL)
+  T reference_update = 0;          // ULSPH (corrected): new kernel reference once max |F - I| exceeds this
+  T artificial_stress = -1;        // ULSPH: epsilon of the artificial stress (default 0 corrected, 0.3 GMS)
   std::string output = "oscillating_plate.csv";
 };
 
@@ -69,10 +71,12 @@ void print_help() {
       "  --youngs E          Young's modulus, Pa (default 2e6; 2e7 with --sag)\n"
       "  --damping c         velocity damping, 1/s (default 0; the first-mode omega with --sag)\n"
       "  --end t             end time, s (sag, default 12 first-mode periods)\n"
-      "  --hourglass a       TLSPH hourglass coefficient (default 0.1)\n"
-      "  --fixed-clamp       TLSPH: wall part held at rest (default: clamped by odd reflection at x = 0)\n"
-      "  --linear-correction TLSPH: Bonet-Lok gradient correction only (no quadratic correction)\n"
-      "  --uncorrected       ULSPH: velocity gradient without kernel-gradient correction (original GMS 2001)\n"
+      "  --hourglass a       hourglass coefficient of TLSPH and corrected ULSPH (default 0.1)\n"
+      "  --fixed-clamp       wall part held at rest (default: clamped by odd reflection at x = 0)\n"
+      "  --linear-correction Bonet-Lok gradient correction only (no quadratic correction)\n"
+      "  --gms               ULSPH: the original Gray, Monaghan & Swift (2001) sums (the paper's eq. 13)\n"
+      "  --artificial-stress e  ULSPH: epsilon of Monaghan's artificial stress (default 0; 0.3 with --gms)\n"
+      "  --reference-update d   ULSPH: new kernel reference configuration once max |F - I| > d (default 0: never)\n"
       "  --h-ratio r         smoothing length over particle spacing (default 1.3)\n"
       "  --cfl c             solid CFL number (default 0.3)\n"
       "  --viscosity a       artificial viscosity alpha (default 0 for tl, 0.5 for ul)\n"
@@ -101,7 +105,9 @@ Options parse(int argc, char** argv) {
     else if (a == "--hourglass") o.hourglass = std::stod(value());
     else if (a == "--h-ratio") o.h_ratio = std::stod(value());
     else if (a == "--cfl") o.cfl = std::stod(value());
-    else if (a == "--uncorrected") o.uncorrected = true;
+    else if (a == "--gms") o.gms = true;
+    else if (a == "--artificial-stress") o.artificial_stress = std::stod(value());
+    else if (a == "--reference-update") o.reference_update = std::stod(value());
     else if (a == "--linear-correction") o.linear_correction = true;
     else if (a == "--fixed-clamp") o.fixed_clamp = true;
     else if (a == "--viscosity") o.viscosity = std::stod(value());
@@ -115,6 +121,7 @@ Options parse(int argc, char** argv) {
   sphfsi::require_positive("--periods", o.periods);
   if (o.youngs < 0) o.youngs = o.sag ? 2e7 : 2e6;
   if (o.viscosity < 0) o.viscosity = o.model == "ul" ? 0.5 : 0.0;
+  if (o.artificial_stress < 0) o.artificial_stress = o.gms ? 0.3 : 0.0;
   return o;
 }
 
@@ -141,7 +148,13 @@ int run(const Options& o) {
   params.damping = o.damping >= 0 ? o.damping : (o.sag ? omega : T(0));
   if constexpr (requires { params.hourglass; }) params.hourglass = o.hourglass;
   if constexpr (requires { params.quadratic_correction; }) params.quadratic_correction = !o.linear_correction;
-  if constexpr (requires { params.corrected_velocity_gradient; }) params.corrected_velocity_gradient = !o.uncorrected;
+  if constexpr (requires { params.formulation; }) {
+    params.formulation = o.gms ? sphfsi::UpdatedLagrangianFormulation::gray_monaghan_swift
+                               : sphfsi::UpdatedLagrangianFormulation::corrected;
+    params.artificial_stress = o.artificial_stress;
+    params.reference_update = o.reference_update;
+    params.quadratic_correction = !o.linear_correction;
+  }
   Model solid(system, 0, material, params);
   static_assert(sphfsi::SolidModel<Model, System>);
   std::size_t clamped = 0;
@@ -200,6 +213,8 @@ int run(const Options& o) {
   });
   const T seconds = std::chrono::duration<T>(std::chrono::steady_clock::now() - start).count();
   csv.close();
+  if constexpr (requires { model.reference_update_count(); })
+    if (model.reference_update_count() > 0) fmt::print("reference updates: {}\n", model.reference_update_count());
 
   fmt::print(
       "model {} | H/dp = {} | dp = {:.4g} m | particles {} ({} clamped) | solid dt = {:.3g} s | "

@@ -2,8 +2,8 @@
 """Plots the oscillating-plate runs: tip deflection against time and the period error against resolution.
 
 usage: /usr/bin/python3 examples/oscillating_plate/plot.py RUN_DIR OUTPUT.png
-RUN_DIR holds the CSV files written by `oscillating_plate --output`, named {tl,ul}_vf01_r{N}.csv
-(N = H/dp); see docs/solids.md for the commands.
+RUN_DIR holds the CSV files written by `oscillating_plate --output`, named {tl,ul,gms}_vf01_r{N}.csv
+(N = H/dp; gms: ULSPH with --gms, the original Gray-Monaghan-Swift sums); see docs/solids.md for the commands.
 """
 import glob
 import math
@@ -31,24 +31,26 @@ def period_of(t, w):
 
 def main(run_dir, output):
     fig, (ax_t, ax_c) = plt.subplots(1, 2, figsize=(12, 4.5))
-    convergence = {"tl": [], "ul": []}
-    for path in sorted(glob.glob(os.path.join(run_dir, "*_vf01_r*.csv")),
-                       key=lambda p: int(re.search(r"_r(\d+)", p).group(1))):
-        model, n = re.search(r"(tl|ul)_vf01_r(\d+)", path).groups()
+    convergence = {"tl": [], "ul": [], "gms": []}
+    names = {"tl": "TLSPH", "ul": "ULSPH", "gms": "ULSPH, original GMS"}
+    runs = [(p, re.search(r"(tl|ul|gms)_vf01_r(\d+)\.csv$", p)) for p in glob.glob(os.path.join(run_dir, "*_vf01_r*.csv"))]
+    for path, match in sorted((r for r in runs if r[1]), key=lambda r: (r[1].group(1), int(r[1].group(2)))):
+        model, n = match.groups()
         d = np.genfromtxt(path, delimiter=",", names=True)
-        style = "-" if model == "tl" else "--"
-        ax_t.plot(d["t"] / PERIOD, d["tip_deflection"] * 1e3, style, label=f"{model.upper()} H/dp = {n}")
+        style = {"tl": "-", "ul": "--", "gms": ":"}[model]
+        ax_t.plot(d["t"] / PERIOD, d["tip_deflection"] * 1e3, style, label=f"{names[model]} H/dp = {n}")
         convergence[model].append((int(n), 100 * (period_of(d["t"], d["tip_deflection"]) - PERIOD) / PERIOD))
     ax_t.set_xlabel("t / T_EB")
     ax_t.set_ylabel("tip deflection (mm)")
     ax_t.set_title("Oscillating plate, V_f = 0.01")
     ax_t.legend(fontsize=8)
-    for model, marker in (("tl", "o"), ("ul", "s")):
+    for model, marker in (("tl", "o"), ("ul", "s"), ("gms", "^")):
         pts = sorted(p for p in convergence[model] if not math.isnan(p[1]))
         if pts:
-            ax_c.loglog([p[0] for p in pts], [abs(p[1]) for p in pts], marker + "-", label=f"{model.upper()}SPH")
+            ax_c.loglog([p[0] for p in pts], [abs(p[1]) for p in pts], marker + ("-" if model == "tl" else "--"),
+                        label=names[model], fillstyle="full" if model == "tl" else "none")
     n_ref = np.array([4, 16])
-    ax_c.loglog(n_ref, 29 * (4 / n_ref) ** 2, "k:", label="slope -2")
+    ax_c.loglog(n_ref, 3.7 * (4 / n_ref) ** 2, "k:", label="slope -2")
     ax_c.axhline(3, color="grey", lw=0.8)
     ax_c.set_xlabel("H / dp")
     ax_c.set_ylabel("|period error| vs Euler-Bernoulli (%)")

@@ -104,6 +104,12 @@ void check_restart(const Parameters& params, const char* label) {
   INFO(label);
   CHECK(reference.template model<0>().solid().sub_step_total() == resumed.template model<0>().solid().sub_step_total());
   CHECK(reference.template model<0>().solid().sub_step_total() > total_steps);  // it did sub-cycle
+  if constexpr (requires { params.reference_update; })
+    if (params.reference_update > 0) {  // the restart crossed new reference configurations of the kernel sums
+      CHECK(reference.template model<0>().solid().reference_update_count() > 0);
+      CHECK(reference.template model<0>().solid().reference_update_count() ==
+            resumed.template model<0>().solid().reference_update_count());
+    }
   CHECK(same_bits(p.position, q.position));
   CHECK(same_bits(p.velocity, q.velocity));
   CHECK(std::memcmp(p.density.data(), q.density.data(), p.density.size() * sizeof(double)) == 0);
@@ -124,6 +130,21 @@ TEST_CASE("Checkpoint: a coupled total-Lagrangian run resumes bit-identically", 
 
 TEST_CASE("Checkpoint: a coupled updated-Lagrangian run resumes bit-identically", "[robustness][checkpoint][solid]") {
   check_restart(UpdatedLagrangianParameters<2, double>{}, "updated_lagrangian");
+}
+
+TEST_CASE("Checkpoint: an updated-Lagrangian run with new reference configurations resumes bit-identically",
+          "[robustness][checkpoint][solid]") {
+  UpdatedLagrangianParameters<2, double> params;
+  params.reference_update = 0.01;  // a new reference configuration every few steps of this scene
+  check_restart(params, "updated_lagrangian_reference");
+}
+
+TEST_CASE("Checkpoint: an original Gray-Monaghan-Swift run resumes bit-identically",
+          "[robustness][checkpoint][solid]") {
+  UpdatedLagrangianParameters<2, double> params;
+  params.formulation = UpdatedLagrangianFormulation::gray_monaghan_swift;
+  params.artificial_stress = 0.3;
+  check_restart(params, "updated_lagrangian_gms");
 }
 
 TEST_CASE("Checkpoint: a solid checkpoint read into another scene gives a clear error",

@@ -69,15 +69,16 @@ std::pair<sphfsi::Vec<Dim, double>, double> momenta(const SolidSystem<Dim>& s) {
 }
 
 /// A free block (no clamp, no gravity) that translates, spins and carries an initial shear deformation.
+/// angular_tolerance: relative change of L allowed (rounding for variational or corrected forces; < 0: not checked).
 template <template <int> class ModelT, int Dim>
-void check_free_body_conservation() {
+void check_free_body_conservation(const typename ModelT<Dim>::Parameters& params, double angular_tolerance) {
   using V = sphfsi::Vec<Dim, double>;
   auto system = make_system<Dim>();
   const double dp = 0.005;
   V hi = V::Constant(4 * dp);
   hi[0] = 8 * dp;
   sphfsi::add_solid_block(system, V::Zero(), hi, sphfsi::Resolution<double>{.dp = dp}, rubber);
-  ModelT<Dim> solid(system, 0, rubber, free_parameters<ModelT<Dim>>());
+  ModelT<Dim> solid(system, 0, rubber, params);
   auto& p = system.particles();
   const V centre = 0.5 * hi;
   for (std::size_t i = 0; i < p.size(); ++i) {
@@ -99,22 +100,18 @@ void check_free_body_conservation() {
   INFO("P0 = " << P0.transpose() << " P1 = " << P1.transpose() << " L0 = " << L0 << " L1 = " << L1);
   CHECK((P1 - P0).norm() < 1e-12 * M);
   CHECK(solid.max_stretch() > 1.01);  // the body did deform (the test exercises the stress forces)
-  // TLSPH is the gradient of a rotation-invariant energy: angular momentum is conserved to rounding. The GMS
-  // pair force (sigma_a/rho_a^2 + sigma_b/rho_b^2) . grad is not central, so ULSPH conserves angular momentum only
-  // to its truncation error, of order strain x (dp / body size)^2 = 0.05 x (1/8)^2 = 8e-4 here.
-  const double tolerance = std::is_same_v<ModelT<Dim>, TL<Dim>> ? 1e-12 : 0.05 / 64;
-  CHECK(std::abs(L1 - L0) < tolerance * std::abs(L0));
+  if (angular_tolerance >= 0) CHECK(std::abs(L1 - L0) < angular_tolerance * std::abs(L0));
 }
 
 /// A block set spinning rigidly at omega: the only physical stress is the centripetal one, of order
 /// rho omega^2 R^2; an inconsistent velocity gradient would add spurious stress of order G x angle.
 template <template <int> class ModelT>
-void check_rigid_rotation_is_stress_free() {
+void check_rigid_rotation_is_stress_free(const typename ModelT<2>::Parameters& params) {
   using V = sphfsi::Vec<2, double>;
   auto system = make_system<2>();
   const double dp = 0.005, omega = 1.0;
   sphfsi::add_solid_block(system, V(0, 0), V(8 * dp, 4 * dp), sphfsi::Resolution<double>{.dp = dp}, rubber);
-  ModelT<2> solid(system, 0, rubber, free_parameters<ModelT<2>>());
+  ModelT<2> solid(system, 0, rubber, params);
   auto& p = system.particles();
   const V centre(4 * dp, 2 * dp);
   for (std::size_t i = 0; i < p.size(); ++i) p.velocity[i] = axis_z_cross<2>(p.position[i] - centre, omega);
@@ -129,6 +126,8 @@ void check_rigid_rotation_is_stress_free() {
   const auto first = p.slot_of_id(0);
   const V r0 = solid.body_data().reference_position()[0] - centre, r1 = p.position[first] - centre;
   CHECK(std::atan2(r0.x() * r1.y() - r0.y() * r1.x(), r0.dot(r1)) == Approx(0.3).margin(0.01));
+  if constexpr (requires { solid.reference_update_count(); })
+    if (params.reference_update > 0) CHECK(solid.reference_update_count() >= 2);  // |R(0.3) - I| = 0.42
 }
 
 /// advance(t, dt) with n sub-steps must equal n calls of advance over dt / n (the external acceleration held).
@@ -172,8 +171,11 @@ void check_sub_cycling_equals_single_steps() {
 }  // namespace
 
 TEST_CASE("Solid models: rigid rotation produces no stress", "[solid]") {
-  check_rigid_rotation_is_stress_free<TL>();
-  check_rigid_rotation_is_stress_free<UL>();
+  check_rigid_rotation_is_stress_free<TL>(free_parameters<TL<2>>());
+  check_rigid_rotation_is_stress_free<UL>(free_parameters<UL<2>>());
+  auto updated = free_parameters<UL<2>>();
+  updated.reference_update = 0.1;  // a new reference configuration every ~0.07 rad: the stress carries over
+  check_rigid_rotation_is_stress_free<UL>(updated);
 }
 
 TEST_CASE("Solid models: sub-cycling equals single stepping", "[solid]") {
@@ -284,13 +286,32 @@ TEST_CASE("ElasticMaterial: derived moduli and input validation", "[solid]") {
   sphfsi::TotalLagrangianParameters<2, double> tl_bad{};
   tl_bad.cfl = 2;
   CHECK_THROWS_WITH(TL<2>(system, 0, rubber, tl_bad), Catch::Contains("cfl"));
+  sphfsi::UpdatedLagrangianParameters<2, double> ul_bad{};
+  ul_bad.formulation = static_cast<sphfsi::UpdatedLagrangianFormulation>(7);
+  CHECK_THROWS_WITH(UL<2>(system, 0, rubber, ul_bad), Catch::Contains("formulation = 7"));
+  ul_bad = {};
+  ul_bad.reference_update = -1;
+  CHECK_THROWS_WITH(UL<2>(system, 0, rubber, ul_bad), Catch::Contains("reference_update"));
 }
 
 TEST_CASE("Solid models conserve momentum in a free, spinning, deformed body", "[solid]") {
-  check_free_body_conservation<TL, 2>();
-  check_free_body_conservation<UL, 2>();
-  check_free_body_conservation<TL, 3>();
-  check_free_body_conservation<UL, 3>();
+  // TLSPH is the gradient of a rotation-invariant energy, and the corrected ULSPH force has
+  // sum_b V_b x_ba (x) g_ab = I with a symmetric stress (Bonet & Lok 1999): angular momentum to rounding. The
+  // artificial viscosity and the hourglass penalty act along the bond (central). The original GMS scheme
+  // conserves linear momentum only: its pair force (sigma_a/rho_a^2 + sigma_b/rho_b^2) . grad is not central, and
+  // its uncorrected velocity gradient turns the spin (20 rad/s) into spurious strain at the free surfaces, so the
+  // angular momentum of this block changes by 35 % (2D) and 74 % (3D) in 8 ms: not checked.
+  auto gms = free_parameters<UL<2>>();
+  gms.formulation = sphfsi::UpdatedLagrangianFormulation::gray_monaghan_swift;
+  gms.artificial_stress = 0.3;
+  auto gms3 = free_parameters<UL<3>>();
+  gms3.formulation = sphfsi::UpdatedLagrangianFormulation::gray_monaghan_swift;
+  check_free_body_conservation<TL, 2>(free_parameters<TL<2>>(), 1e-12);
+  check_free_body_conservation<UL, 2>(free_parameters<UL<2>>(), 1e-12);
+  check_free_body_conservation<UL, 2>(gms, -1);
+  check_free_body_conservation<TL, 3>(free_parameters<TL<3>>(), 1e-12);
+  check_free_body_conservation<UL, 3>(free_parameters<UL<3>>(), 1e-12);
+  check_free_body_conservation<UL, 3>(gms3, -1);
 }
 
 TEST_CASE("TLSPH: quadratic gradient correction makes F exact for a quadratic deformation, surfaces included",
@@ -384,4 +405,95 @@ TEST_CASE("TLSPH: oscillating plate period at H/dp = 4 within 4 % of Euler-Berno
   INFO("period " << measured << " s, Euler-Bernoulli " << period << " s, error " << 100 * error << " %");
   CHECK(error > 0.03);  // the quadrature deficit alone is +3.1 %: a smaller error would hide a new bias
   CHECK(error < 0.04);
+}
+
+namespace {
+/// Result of an undamped oscillating-plate run (Gray et al. 2001 set-up, V_f = 0.01, clamped by reflection at x = 0).
+struct PlateRun {
+  double period_error;    ///< (measured - Euler-Bernoulli) / Euler-Bernoulli, from the zero crossings
+  double energy_low = 1;  ///< smallest (kinetic + stored) / initial
+  double energy_high = 1;
+  double max_stretch = 1;
+};
+
+/// Runs a plate of length L and thickness 0.02 m with n particles across for `periods` Euler-Bernoulli periods,
+/// sampling the mean tip deflection and the energy every T/200.
+template <class Model>
+PlateRun run_plate(typename Model::Parameters params, double L, int n, double periods) {
+  using V = sphfsi::Vec<2, double>;
+  auto system = make_system<2>();
+  const double H = 0.02, dp = H / n, kL = 1.875, k = kL / L;
+  sphfsi::add_solid_block(system, V(-3 * dp, -H / 2), V(L, H / 2), sphfsi::Resolution<double>{.dp = dp}, rubber);
+  params.gravity.setZero();
+  Model solid(system, 0, rubber, params);
+  REQUIRE(solid.clamp_by_reflection(V(0, 0), V(1, 0)) == std::size_t(3 * n));
+  const double M = std::sin(kL) + std::sinh(kL), N = std::cos(kL) + std::cosh(kL);
+  const double Q = 2 * (std::cos(kL) * std::sinh(kL) - std::sin(kL) * std::cosh(kL));
+  auto& p = system.particles();
+  std::vector<std::uint32_t> tip;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const double x = p.position[i].x();
+    if (x > L - dp) tip.push_back(p.id[i]);
+    if (x > 0)
+      p.velocity[i].y() = 0.01 * rubber.sound_speed() *
+                          (M * (std::cos(k * x) - std::cosh(k * x)) - N * (std::sin(k * x) - std::sinh(k * x))) / Q;
+  }
+  auto w = [&]() {
+    double y = 0;
+    for (auto id : tip) y += system.particles().position[system.particles().slot_of_id(id)].y();
+    return y / double(tip.size());
+  };
+  solid.compute_rates(system, 0.0);
+  const double e0 = solid.kinetic_energy() + solid.strain_energy();
+  const double Ep = rubber.plane_strain_modulus();
+  const double period = 2 * std::numbers::pi / std::sqrt(Ep * H * H * k * k * k * k / (12 * rubber.density));
+  const double frame = period / 200;
+  std::vector<double> crossings;
+  PlateRun run{};
+  double t = 0, w_prev = w();
+  for (int s = 0; s < int(std::lround(periods * 200)); ++s) {
+    solid.advance(system, t, frame);
+    t += frame;
+    const double w_now = w();
+    if (s > 0 && (w_prev < 0) != (w_now < 0)) crossings.push_back(t - frame * w_now / (w_now - w_prev));
+    w_prev = w_now;
+    const double e = (solid.kinetic_energy() + solid.strain_energy()) / e0;
+    run.energy_low = std::min(run.energy_low, e);
+    run.energy_high = std::max(run.energy_high, e);
+    run.max_stretch = std::max(run.max_stretch, solid.max_stretch());
+  }
+  REQUIRE(crossings.size() >= 3);
+  const double measured = 2 * (crossings.back() - crossings.front()) / double(crossings.size() - 1);
+  run.period_error = (measured - period) / period;
+  return run;
+}
+}  // namespace
+
+TEST_CASE("ULSPH: oscillating plate period at H/dp = 4 within 4 % of Euler-Bernoulli", "[solid]") {
+  // The corrected formulation (quadratic-consistent weights on the reference configuration of the kernel sums,
+  // compatible force, reflected clamp) has the same remaining errors as the TLSPH plate: the midpoint quadrature
+  // of the second moment of area (+3.1 % on the period at N = 4) and shear / rotary inertia (+0.7 %): the example
+  // measures +3.73 %. The original GMS sums gave +40 % here. Default artificial viscosity (alpha = 0.5).
+  const auto run = run_plate<UL<2>>(free_parameters<UL<2>>(), 0.2, 4, 1.65);
+  INFO("period error " << 100 * run.period_error << " %, max stretch " << run.max_stretch);
+  CHECK(run.period_error > 0.03);  // the quadrature deficit alone is +3.1 %: a smaller error would hide a new bias
+  CHECK(run.period_error < 0.04);
+  CHECK(run.max_stretch < 1.05);  // bending strain of the outer fibres at V_f = 0.01 is about 3 %
+}
+
+TEST_CASE("ULSPH: energy of the undamped oscillating plate stays within 1 % over 5 periods", "[solid]") {
+  // A plate of half the length (period T/4, so 5 periods are cheap) at H/dp = 4, no artificial viscosity or
+  // damping. Kinetic plus stored energy (S:S/4G + p^2/2K) is what the rates conserve: the force is compatible
+  // with the velocity gradient (its power is minus the stress power) and the kick-drift-kick step is
+  // second order; what remains is the hourglass penalty (not derived from an energy, alpha_hg = 0.1) and the
+  // O(strain) difference between the hypoelastic stored energy and the work of the forces. The 1 % band is the order of
+  // the strain (3 %) times alpha_hg (0.1) times 3 for the shape of the mode, and a leak of 1 % per 5 periods would show
+  // as 0.2 % amplitude decay per period. Measured: E/E0 in [0.9983, 1.0000].
+  auto params = free_parameters<UL<2>>();
+  params.artificial_viscosity = 0;
+  const auto run = run_plate<UL<2>>(params, 0.1, 4, 5);
+  INFO("E/E0 in [" << run.energy_low << ", " << run.energy_high << "], max stretch " << run.max_stretch);
+  CHECK(run.energy_low > 0.99);
+  CHECK(run.energy_high < 1.01);
+  CHECK(run.max_stretch < 1.1);  // the plate stays intact
 }

@@ -5,6 +5,8 @@
 // (positions X, volumes V0 = m / rho0, the pairs within the kernel support) is the configuration at construction.
 // Per-particle data are held in body order (local index k = 0 .. size()-1, in increasing particle id), so they
 // survive the system's re-sorting; gather()/scatter() move state between the particle set and body order.
+// Shared by both solid models: the clamps (held particles, or odd reflection about a wall plane), the stretch
+// diagnostic, the sub-cycling loop and the kernel-gradient weights exact for quadratic fields.
 #pragma once
 
 #include <sphfsi/core/error.hpp>
@@ -13,6 +15,9 @@
 #include <sphfsi/core/types.hpp>
 #include <sphfsi/solid/detail/pair_list.hpp>
 #include <sphfsi/solid/elastic_material.hpp>
+
+#include <Eigen/LU>
+#include <Eigen/SVD>
 
 #include <algorithm>
 #include <cmath>
@@ -47,6 +52,7 @@ class SolidBody {
     mass_.resize(n);
     h_.resize(n);
     clamped_.assign(n, 0);
+    mirror_.assign(n, -1);
     x.resize(n);
     v.resize(n);
     a_ext.assign(n, Vector::Zero());
@@ -99,6 +105,46 @@ class SolidBody {
     clamped_[static_cast<std::size_t>(k)] = 1;
   }
 
+  /// Clamps the particles behind the plane through `point` with normal `normal` (pointing into the free part)
+  /// by odd reflection: each becomes the image of the free particle at its mirror position and moves with minus
+  /// its displacement and velocity (reflect_images()), so the displacement vanishes on the plane itself (a clamp
+  /// at the wall face, not dp/2 inside it). Every such particle must have a free particle at its mirror position
+  /// (a lattice symmetric about the plane). Returns the number of image particles.
+  std::size_t clamp_by_reflection(const Vector& point, const Vector& normal) {
+    const Vector nn = normal.normalized();
+    const T tolerance = T(1e-6) * spacing_;
+    std::size_t count = 0;
+    for (std::size_t k = 0; k < size(); ++k) {
+      const T depth = (reference_position_[k] - point).dot(nn);
+      if (!(depth < T(0))) continue;
+      const Vector image = reference_position_[k] - T(2) * depth * nn;
+      std::int64_t m = -1;
+      for (std::size_t j = 0; j < size(); ++j)
+        if ((reference_position_[j] - image).norm() < tolerance) m = static_cast<std::int64_t>(j);
+      if (m < 0 || (reference_position_[m] - point).dot(nn) <= T(0))
+        throw InputError(
+            fmt::format("clamp_by_reflection: particle id {} at [{}] has no free particle at its "
+                        "mirror position: the lattice must be symmetric about the clamp plane",
+                        ids_[k], format_vector(reference_position_[k])));
+      mirror_[k] = m;
+      clamped_[k] = 1;
+      ++count;
+    }
+    return count;
+  }
+  /// Body-order index of the mirror of a reflected clamp particle, or -1 (a free or held particle).
+  std::int64_t mirror(std::size_t k) const { return mirror_[k]; }
+  bool is_image(std::size_t k) const { return mirror_[k] >= 0; }
+  /// Places each reflected clamp particle g at X_g - (x_m - X_m) with velocity -v_m (m its mirror).
+  void reflect_images() {
+    for (std::size_t g = 0; g < size(); ++g)
+      if (mirror_[g] >= 0) {
+        const auto k = static_cast<std::size_t>(mirror_[g]);
+        x[g] = reference_position_[g] - (x[k] - reference_position_[k]);
+        v[g] = -v[k];
+      }
+  }
+
   /// Reads positions, velocities and external accelerations (the coupling's fluid force per unit mass).
   void gather(const ParticleSet<Dim, T>& p) {
     for (std::size_t k = 0; k < size(); ++k) {
@@ -135,6 +181,17 @@ class SolidBody {
         if (r0 > T(0)) s = std::max(s, (x[a] - x[b]).norm() / r0);
       });
     return s;
+  }
+
+  /// Throws BlowUpError when max_stretch() exceeds `limit` (0: no limit) at the end of a step ending at `time`.
+  void check_stretch_limit(T limit, T time) const {
+    if (!(limit > T(0))) return;
+    const T s = max_stretch();
+    if (s > limit)
+      throw BlowUpError(
+          fmt::format("solid body {} at t = {:.6g} s: largest stretch between initially "
+                      "neighbouring particles is {:.4g} > stretch_limit = {:.4g} (the body tore)",
+                      body_, time, s, limit));
   }
 
   /// Kinetic energy sum m v^2 / 2, J (J/m per unit depth in 2D).
@@ -179,6 +236,7 @@ class SolidBody {
   std::vector<Vector> reference_position_;
   std::vector<T> volume_, mass_, h_;
   std::vector<std::uint8_t> clamped_;
+  std::vector<std::int64_t> mirror_;  // mirror of a reflected clamp particle, -1 otherwise
   T spacing_{0};
   detail::PairList reference_pairs_;
 };
@@ -199,6 +257,66 @@ std::size_t sub_step_count(T dt, T dt_stable) {
   if (!(dt > T(0))) return 0;
   const T n = std::ceil(dt / dt_stable * (T(1) - T(64) * std::numeric_limits<T>::epsilon()));
   return static_cast<std::size_t>(std::max(T(1), n));
+}
+
+/// The sub-cycling of both solid models: covers [time, time + dt] with sub_step_count(dt, dt_stable) equal
+/// sub-steps, calling step(h, t_end) for each (h the sub-step, t_end the time at its end). Returns their number.
+template <class T, class Step>
+std::size_t for_each_sub_step(T time, T dt, T dt_stable, Step&& step) {
+  const std::size_t n_sub = sub_step_count(dt, dt_stable);
+  const T h = dt / T(n_sub);
+  for (std::size_t s = 0; s < n_sub; ++s) step(h, time + T(s + 1) * h);
+  return n_sub;
+}
+
+/// Kernel-gradient weights of particle a exact for quadratic fields. With Delta = x_b - x_a over the pairs k of
+/// a (neighbour pairs.neighbor[k], kernel gradient grad[k] = grad_a W_ab, value w[k]), the Taylor expansion
+/// phi_b - phi_a = grad phi . Delta + Delta_i Delta_j H_ij / 2 is tested with t_ab = [grad_ab; W_ab Delta_i Delta_j]
+/// and summed with the volumes V_b; solving the (Dim + Dim(Dim+1)/2)-square system for the gradient gives weights
+/// g_ab with sum_b V_b (phi_b - phi_a) g_ab = grad phi for every quadratic phi (a second-order Taylor-series
+/// correction as in the finite particle method; Liu & Liu 2010, Arch. Comput. Methods Eng. 17:25, sec. 4). On a
+/// symmetric lattice in the interior the system is block-diagonal and g_ab equals the Bonet & Lok (1999) weights B_a^T
+/// grad_ab; at a free surface the one-sided support no longer biases the gradient of a bending field towards the
+/// inside. Writes weight[k] and returns true; returns false (weights untouched) where the neighbours do not determine a
+/// quadratic (fewer than three rows in some direction: smallest singular value below condition_limit times the
+/// largest).
+template <int Dim, class T>
+bool quadratic_gradient_weights(std::size_t a, const PairList& pairs, const std::vector<Vec<Dim, T>>& x,
+                                const std::vector<T>& volume, T h, const std::vector<Vec<Dim, T>>& grad,
+                                const std::vector<T>& w, std::vector<Vec<Dim, T>>& weight, T condition_limit) {
+  constexpr int Q = Dim * (Dim + 1) / 2, M = Dim + Q;
+  using Moment = Eigen::Matrix<T, M, M>;
+  using Column = Eigen::Matrix<T, M, 1>;
+  const T scale = std::pow(h, T(Dim));
+  auto monomials = [&](const Vec<Dim, T>& d) {  // [Delta / h; Delta_i Delta_j / h^2]
+    Column p;
+    for (int i = 0; i < Dim; ++i) p[i] = d[i] / h;
+    int q = Dim;
+    for (int i = 0; i < Dim; ++i)
+      for (int j = i; j < Dim; ++j) p[q++] = d[i] * d[j] / (h * h);
+    return p;
+  };
+  auto test = [&](std::uint32_t k, const Column& p) {  // [grad h^(Dim+1); W h^Dim Delta_i Delta_j / h^2]
+    Column t;
+    t.template head<Dim>() = grad[k] * (scale * h);
+    t.template tail<Q>() = w[k] * scale * p.template tail<Q>();
+    return t;
+  };
+  Moment A = Moment::Zero();
+  for (std::uint32_t k = pairs.offset[a]; k < pairs.offset[a + 1]; ++k) {
+    const std::uint32_t b = pairs.neighbor[k];
+    const Column p = monomials(x[b] - x[a]);
+    A += (volume[b] / scale) * test(k, p) * p.transpose();
+  }
+  const Eigen::JacobiSVD<Moment> svd(A);
+  const auto& sv = svd.singularValues();
+  if (!(sv[M - 1] > condition_limit * sv[0])) return false;
+  const Moment inverse = A.inverse();
+  for (std::uint32_t k = pairs.offset[a]; k < pairs.offset[a + 1]; ++k) {
+    const Column p = monomials(x[pairs.neighbor[k]] - x[a]);
+    weight[k] = (inverse * test(k, p)).template head<Dim>() / (scale * h);
+  }
+  return true;
 }
 }  // namespace detail
 

@@ -132,7 +132,6 @@ class TotalLagrangianSolid {
     F_.assign(n, Matrix::Identity());
     P_.assign(n, Matrix::Zero());
     a_int_.assign(n, Vector::Zero());
-    mirror_.assign(n, -1);
     if (params_.quadratic_correction)
       for (std::size_t a = 0; a < n; ++a) quadratic_[a] = quadratic_gradient_weights(a);
     highest_frequency_ = highest_frequency();
@@ -149,26 +148,7 @@ class TotalLagrangianSolid {
   /// so the displacement vanishes on the plane itself (a clamp at the wall face). Every such particle must have
   /// a free particle at its mirror position (a lattice symmetric about the plane). Returns their number.
   std::size_t clamp_by_reflection(const Vector& point, const Vector& normal) {
-    const Vector nn = normal.normalized();
-    const auto& X = body_.reference_position();
-    const T tolerance = T(1e-6) * body_.reference_spacing();
-    std::size_t count = 0;
-    for (std::size_t k = 0; k < body_.size(); ++k) {
-      const T depth = (X[k] - point).dot(nn);
-      if (!(depth < T(0))) continue;
-      const Vector image = X[k] - T(2) * depth * nn;
-      std::int64_t m = -1;
-      for (std::size_t j = 0; j < body_.size(); ++j)
-        if ((X[j] - image).norm() < tolerance) m = static_cast<std::int64_t>(j);
-      if (m < 0 || (X[m] - point).dot(nn) <= T(0))
-        throw InputError(
-            fmt::format("clamp_by_reflection: particle id {} at [{}, {}] has no free particle at its "
-                        "mirror position: the lattice must be symmetric about the clamp plane",
-                        body_.particle_ids()[k], X[k][0], X[k][1]));
-      mirror_[k] = m;
-      body_.clamp(body_.particle_ids()[k]);
-      ++count;
-    }
+    const std::size_t count = body_.clamp_by_reflection(point, normal);
     highest_frequency_ = highest_frequency();  // the images couple each particle near the plane to its mirror
     return count;
   }
@@ -197,15 +177,13 @@ class TotalLagrangianSolid {
       internal_acceleration();
       initialised_ = true;
     }
-    const std::size_t n_sub = detail::sub_step_count(dt, solid_time_step());
-    const T h = dt / T(n_sub);
     const std::size_t n = body_.size();
     const Vector g = params_.gravity;
     const auto& X = body_.reference_position();
-    for (std::size_t s = 0; s < n_sub; ++s) {
+    sub_steps_ += detail::for_each_sub_step(time, dt, solid_time_step(), [&](T h, T t_end) {
       detail::for_each_solid_particle(n, [&](std::size_t k) {
         if (body_.is_clamped(k)) {
-          if (mirror_[k] >= 0) return;
+          if (body_.is_image(k)) return;
           body_.x[k] = X[k];
           body_.v[k] = Vector::Zero();
           return;
@@ -213,23 +191,15 @@ class TotalLagrangianSolid {
         body_.v[k] += T(0.5) * h * (a_int_[k] + body_.a_ext[k] + g);
         body_.x[k] += h * body_.v[k];
       });
-      reflect_images();
+      body_.reflect_images();
       internal_acceleration();
       detail::for_each_solid_particle(n, [&](std::size_t k) {
         if (!body_.is_clamped(k)) body_.v[k] += T(0.5) * h * (a_int_[k] + body_.a_ext[k] + g);
       });
-      reflect_images();
-      check(time + T(s + 1) * h);
-    }
-    sub_steps_ += n_sub;
-    if (params_.stretch_limit > T(0)) {
-      const T s = body_.max_stretch();
-      if (s > params_.stretch_limit)
-        throw BlowUpError(
-            fmt::format("solid body {} at t = {:.6g} s: largest stretch between initially "
-                        "neighbouring particles is {:.4g} > stretch_limit = {:.4g} (the body tore)",
-                        body_.body(), time + dt, s, params_.stretch_limit));
-    }
+      body_.reflect_images();
+      check(t_end);
+    });
+    body_.check_stretch_limit(params_.stretch_limit, time + dt);
     body_.scatter(p);
     publish(p);
   }
@@ -271,7 +241,7 @@ class TotalLagrangianSolid {
     const T lambda = material_.lame_lambda(), mu = material_.shear_modulus();
     T e = T(0);
     for (std::size_t k = 0; k < body_.size(); ++k) {
-      if (mirror_[k] >= 0) continue;  // images of a reflected clamp store no energy
+      if (body_.is_image(k)) continue;  // images of a reflected clamp store no energy
       const Matrix E = T(0.5) * (F_[k].transpose() * F_[k] - Matrix::Identity());
       const T tr = E.trace();
       e += body_.volume()[k] * (T(0.5) * lambda * tr * tr + mu * E.squaredNorm());
@@ -348,7 +318,7 @@ class TotalLagrangianSolid {
       const Matrix E = T(0.5) * (F_[a].transpose() * F_[a] - Matrix::Identity());
       const Matrix S = lambda * E.trace() * Matrix::Identity() + T(2) * mu * E;
       P_[a] = F_[a] * S;
-      if (mirror_[a] >= 0) P_[a].setZero();  // image of the body: no energy of its own
+      if (body_.is_image(a)) P_[a].setZero();  // image of the body: no energy of its own
     });
     const T alpha_hg = params_.hourglass * material_.youngs_modulus;
     const T alpha_av = params_.artificial_viscosity;
@@ -365,7 +335,7 @@ class TotalLagrangianSolid {
         const Vector e = x_ba / r;
         const Vector X_ba = X[b] - X[a];
         const T r0 = X_ba.norm();
-        if (alpha_hg > T(0) && mirror_[a] < 0 && mirror_[b] < 0) {  // images carry no energy: no hourglass
+        if (alpha_hg > T(0) && !body_.is_image(a) && !body_.is_image(b)) {  // images carry no energy: no hourglass
           const T delta = ((T(0.5) * (F_[a] + F_[b]) * X_ba - x_ba).dot(e)) / r0;
           force -= (alpha_hg * V0[a] * V0[b] * w0_[k] * delta / r0) * e;
         }
@@ -384,58 +354,21 @@ class TotalLagrangianSolid {
     });
     // The images move with minus their mirror's displacement: the force on an image acts on its mirror reversed.
     for (std::size_t g = 0; g < n; ++g)
-      if (mirror_[g] >= 0) {
-        const auto k = static_cast<std::size_t>(mirror_[g]);
+      if (body_.is_image(g)) {
+        const auto k = static_cast<std::size_t>(body_.mirror(g));
         a_int_[k] -= (a_int_[g] + c_d * v[g]) * (m[g] / m[k]);
       }
   }
 
-  /// Gradient weights of particle a exact for quadratic fields: with Delta = X_b - X_a, the Taylor expansion
-  /// phi_b - phi_a = grad phi . Delta + (Hessian terms) is tested with t_ab = [grad0_ab; W0_ab Delta_i Delta_j]
-  /// and summed with the volumes V0_b; solving the (Dim + Dim(Dim+1)/2)-square system for the gradient gives
-  /// weights g_ab with sum_b V0_b (phi_b - phi_a) g_ab = grad phi for every quadratic phi. On a symmetric
-  /// lattice in the interior the system is block-diagonal and g_ab = B_a^T grad0_ab (Bonet & Lok); at a free
-  /// surface the one-sided support no longer biases the strain of bending towards the inside.
-  /// Keeps the Bonet-Lok weights (returns 0) where the neighbours do not determine a quadratic (fewer than
-  /// three rows in some direction).
+  /// Gradient weights of particle a exact for quadratic fields on the reference configuration (see
+  /// detail::quadratic_gradient_weights); keeps the Bonet-Lok weights (returns 0) where the neighbours do not
+  /// determine a quadratic (fewer than three rows in some direction).
   std::uint8_t quadratic_gradient_weights(std::size_t a) {
-    constexpr int Q = Dim * (Dim + 1) / 2, M = Dim + Q;
-    using Moment = Eigen::Matrix<T, M, M>;
-    using Column = Eigen::Matrix<T, M, 1>;
-    const auto& pairs = body_.reference_pairs();
-    const auto& X = body_.reference_position();
-    const auto& V0 = body_.volume();
-    const T h = body_.smoothing_length()[a];
-    const T scale = std::pow(h, T(Dim));
-    auto monomials = [&](const Vector& d) {  // [Delta / h; Delta_i Delta_j / h^2]
-      Column p;
-      for (int i = 0; i < Dim; ++i) p[i] = d[i] / h;
-      int q = Dim;
-      for (int i = 0; i < Dim; ++i)
-        for (int j = i; j < Dim; ++j) p[q++] = d[i] * d[j] / (h * h);
-      return p;
-    };
-    auto test = [&](std::uint32_t k, const Column& p) {  // [grad0 h^(Dim+1); W0 h^Dim Delta_i Delta_j / h^2]
-      Column t;
-      t.template head<Dim>() = grad0_[k] * (scale * h);
-      t.template tail<Q>() = w0_[k] * scale * p.template tail<Q>();
-      return t;
-    };
-    Moment A = Moment::Zero();
-    for (std::uint32_t k = pairs.offset[a]; k < pairs.offset[a + 1]; ++k) {
-      const std::uint32_t b = pairs.neighbor[k];
-      const Column p = monomials(X[b] - X[a]);
-      A += (V0[b] / scale) * test(k, p) * p.transpose();
-    }
-    const Eigen::JacobiSVD<Moment> svd(A);
-    const auto& sv = svd.singularValues();
-    if (!(sv[M - 1] > quadratic_condition_limit * sv[0])) return 0;
-    const Moment inverse = A.inverse();
-    for (std::uint32_t k = pairs.offset[a]; k < pairs.offset[a + 1]; ++k) {
-      const Column p = monomials(X[pairs.neighbor[k]] - X[a]);
-      gradient_weight_[k] = (inverse * test(k, p)).template head<Dim>() / (scale * h);
-    }
-    return 1;
+    return detail::quadratic_gradient_weights<Dim, T>(a, body_.reference_pairs(), body_.reference_position(),
+                                                      body_.volume(), body_.smoothing_length()[a], grad0_, w0_,
+                                                      gradient_weight_, quadratic_condition_limit)
+               ? 1
+               : 0;
   }
   static constexpr T quadratic_condition_limit = T(1e-6);
   static constexpr T frequency_step_factor = T(4);  // omega_max dt <= 4 cfl (1.2, 60 % of the limit 2, at cfl 0.3)
@@ -473,17 +406,6 @@ class TotalLagrangianSolid {
     return std::sqrt(lambda);
   }
 
-  /// Places each reflected clamp particle at X_g - (x_m - X_m) with velocity -v_m (its mirror m).
-  void reflect_images() {
-    const auto& X = body_.reference_position();
-    for (std::size_t g = 0; g < body_.size(); ++g)
-      if (mirror_[g] >= 0) {
-        const auto k = static_cast<std::size_t>(mirror_[g]);
-        body_.x[g] = X[g] - (body_.x[k] - X[k]);
-        body_.v[g] = -body_.v[k];
-      }
-  }
-
   void check(T time) const {
     body_.check_finite(time);  // first: a bad position or velocity is the origin, bad stresses follow from it
     for (std::size_t k = 0; k < body_.size(); ++k)
@@ -515,7 +437,6 @@ class TotalLagrangianSolid {
   std::vector<std::uint8_t> quadratic_;  // 1 where the weights are exact for quadratic fields
   std::vector<Matrix> F_, P_;            // deformation gradient, PK1 stress (Pa)
   T highest_frequency_{0};               // omega_max of the linearised body with its reflected clamps, rad/s
-  std::vector<std::int64_t> mirror_;     // mirror particle of a reflected clamp particle, -1 otherwise
   std::vector<Vector> a_int_;            // internal acceleration, m/s^2
   std::size_t sub_steps_{0};
   bool initialised_{false};
