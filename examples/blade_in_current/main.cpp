@@ -56,6 +56,7 @@ struct Options {
   T particles_along = 15;  // l / dp
   T nominal_drag = 2.0;    // C_D used to choose E for a target Ca (the measured one is reported)
   T tow_lengths = 8;       // towing distance after the ramp, in blade lengths
+  T depth_lengths = 3;     // channel depth in blade lengths (blockage l / depth)
   T average_from = 3;      // the drag is averaged once the blade has moved this many lengths after the ramp
   std::vector<T> cauchy{0, 1, 3, 10, 30, 100, 300, 1000};  // 0: the rigid blade
   std::filesystem::path output = "out/blade_in_current";
@@ -72,7 +73,7 @@ T model_effective_length(T ca) {
 }
 
 CaseResult run_case(const Options& o, T target_ca) {
-  const T l = o.length, dp = l / o.particles_along, depth = 3 * l, U = o.speed, rho = 1000;
+  const T l = o.length, dp = l / o.particles_along, depth = o.depth_lengths * l, U = o.speed, rho = 1000;
   const T x0 = 2 * l, ramp = T(0.25), tow = o.tow_lengths * l;
   const T tank = x0 + U * ramp / 2 + tow + 3 * l;
   const T c0 = 20 * U;  // the flow around the blade's tip reaches about 2 U: c0 >= 10 x that
@@ -97,6 +98,7 @@ CaseResult run_case(const Options& o, T target_ca) {
   params.section = section;
   params.gravity = V::Zero();
   Rod rod(system, 1, material, params);
+  rod.set_contact_plane(V(0, 0), V(0, 1), dp / 2);  // a blade folding over rests on the bed, it does not cross it
   if (target_ca > 0) rod.clamp_base();
   else rod.clamp_where([](const V&) { return true; });  // the rigid reference blade
   // Towing: velocity U (1 - cos(pi t / ramp)) / 2 during the ramp, U after it.
@@ -167,6 +169,7 @@ int main(int argc, char** argv) try {
   o.thickness = cli.get_number("thickness", o.thickness, "blade thickness t, m");
   o.particles_along = cli.get_number("resolution", o.particles_along, "fluid particles along the blade, l / dp");
   o.tow_lengths = cli.get_number("tow-lengths", o.tow_lengths, "towing distance after the ramp, blade lengths");
+  o.depth_lengths = cli.get_number("depth", o.depth_lengths, "channel depth in blade lengths (blockage 1 / depth)");
   o.average_from = cli.get_number("average-from", o.average_from, "start of the drag average, blade lengths");
   const std::string list = cli.get("cauchy", "0,1,3,10,30,100,300,1000", "target Cauchy numbers (0: rigid blade)");
   o.output = cli.get("output", o.output.string(), "output folder");
@@ -175,6 +178,7 @@ int main(int argc, char** argv) try {
   require_positive("--length (m)", o.length);
   require_positive("--thickness (m)", o.thickness);
   require_in_range("--resolution (l / dp)", o.particles_along, T(5), T(200));
+  require_in_range("--depth (blade lengths)", o.depth_lengths, T(1.5), T(20));
   require_in_range("--average-from (blade lengths)", o.average_from, T(0), o.tow_lengths - T(1));
   o.cauchy.clear();
   std::stringstream ss(list);
@@ -190,8 +194,8 @@ int main(int argc, char** argv) try {
   }
   const T rigid = results.front().drag, rho = 1000;
   const T drag_coefficient = rigid / (T(0.5) * rho * o.speed * o.speed * o.length);
-  fmt::print("rigid blade: F = {:.4g} +- {:.2g} N/m, C_D = {:.3f} (blockage l / depth = 1/3 included)\n", rigid,
-             results.front().drag_error, drag_coefficient);
+  fmt::print("rigid blade: F = {:.4g} +- {:.2g} N/m, C_D = {:.3f} (blockage l / depth = {:.3g} included)\n", rigid,
+             results.front().drag_error, drag_coefficient, 1 / o.depth_lengths);
   io::CsvWriter summary(o.output / "summary.csv",
                         {"target_ca", "ca", "youngs_modulus", "drag", "drag_error", "effective_length",
                          "effective_length_error", "model", "tip_dx", "tip_dy", "steps", "particles", "wall_s"});

@@ -231,6 +231,18 @@ class ElasticRod {
     clamp_velocity_ = std::move(velocity);
   }
 
+  /// A rigid plane the nodes cannot cross (a bed under a blade that folds over): a node closer than `gap` to the
+  /// plane through `point` with unit normal `normal` (pointing to the free side) is put back at `gap` and loses
+  /// the velocity component into the plane (inelastic contact, no friction). Without it the rod meets no walls.
+  void set_contact_plane(const Vector& point, const Vector& normal, T gap) {
+    require_positive("ElasticRod::set_contact_plane |normal|", normal.norm());
+    require_non_negative("ElasticRod::set_contact_plane gap (m)", gap);
+    contact_point_ = point;
+    contact_normal_ = normal.normalized();
+    contact_gap_ = gap;
+    has_contact_ = true;
+  }
+
   /// Clamps the base (node 0): position and tangent held. Returns the number of held nodes.
   std::size_t clamp_base() {
     held_[0] = 1;
@@ -274,6 +286,14 @@ class ElasticRod {
         }
         v_[k] += T(0.5) * h * (a_int_[k] + a_ext_[k] + g);
         x_[k] += h * v_[k];
+        if (has_contact_) {
+          const T d = (x_[k] - contact_point_).dot(contact_normal_);
+          if (d < contact_gap_) {
+            x_[k] += (contact_gap_ - d) * contact_normal_;
+            const T vn = v_[k].dot(contact_normal_);
+            if (vn < T(0)) v_[k] -= vn * contact_normal_;
+          }
+        }
       }
       internal_forces();
       for (std::size_t k = 0; k < n; ++k)
@@ -540,6 +560,9 @@ class ElasticRod {
   T omega_max_{0};                                 // rad/s
   std::size_t sub_steps_{0};
   std::function<Vector(T)> clamp_displacement_, clamp_velocity_;  // motion of the held nodes (empty: at rest)
+  Vector contact_point_ = Vector::Zero(), contact_normal_ = Vector::UnitY();  // contact plane, m
+  T contact_gap_{0};                                                          // m
+  bool has_contact_{false};
 };
 
 }  // namespace sphfsi
