@@ -677,12 +677,12 @@ class UpdatedLagrangianSolid {
   std::size_t reference_updates_{0};
   T step_{1};                            // the current sub-step, s
   std::vector<Vector> a_int_;            // internal acceleration, m/s^2
-  detail::PairList pairs_;               // Verlet list (support + skin) of the current configuration
+  detail::PairList pairs_;               // pairs of x_ref (corrected) or Verlet list of the current positions (GMS)
   std::vector<std::uint32_t> reverse_;   // index of the pair (b, a) of each pair (a, b)
-  std::vector<Vector> grad_;             // kernel gradient grad_a W_ab per pair (zero beyond the support), 1/m^(Dim+1)
-  std::vector<T> w_;                     // kernel value per pair, 1/m^Dim
+  std::vector<Vector> grad_;             // kernel gradient grad_a W_ab per pair on x_ref, 1/m^(Dim+1)
+  std::vector<T> w_;                     // kernel value per pair on x_ref, 1/m^Dim
   std::vector<Vector> weight_;           // corrected gradient weight g_ab per pair, 1/m^(Dim+1)
-  std::vector<std::uint8_t> quadratic_;  // 1 where the weights are exact for quadratic fields (set on X)
+  std::vector<std::uint8_t> quadratic_;  // 1 where the weights are exact for quadratic fields (on x_ref)
   std::vector<Vector> x_at_build_;
   T skin_{0};
   T highest_frequency_{0};  // omega_max of the linearised body (corrected formulation), rad/s
