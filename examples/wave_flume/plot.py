@@ -26,6 +26,8 @@ a.set_xlabel("t (s)")
 a.set_ylabel("eta (mm), offset per gauge")
 a.legend(fontsize=7, loc="upper left")
 b.plot(h["x_over_L"], h["H_over_target"], "o-", label="SPH (zero up-crossing mean)")
+if "H_theory_over_target" in h:
+    b.plot(h["x_over_L"], h["H_theory_over_target"], "k--", lw=0.8, label="second-order theory, this paddle signal")
 b.axhline(1.0, color="k", lw=0.8, label="target (Biesel, linear theory)")
 b.axhspan(0.95, 1.05, color="g", alpha=0.1, label="+-5 %")
 b.set_xlabel("x / L")

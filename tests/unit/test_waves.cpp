@@ -8,6 +8,7 @@
 #include <sphfsi/waves/damping_zone.hpp>
 #include <sphfsi/waves/gauges.hpp>
 #include <sphfsi/waves/linear_theory.hpp>
+#include <sphfsi/waves/second_order.hpp>
 #include <sphfsi/waves/wavemaker.hpp>
 
 #include <catch2/catch.hpp>
@@ -141,6 +142,97 @@ TEST_CASE("wavemaker: Biesel stroke, ramp, velocity, piston and flap motions", "
   bad = {};
   bad.period = -1;
   CHECK_THROWS_AS(waves::Wavemaker<double>(bad), InputError);
+}
+
+TEST_CASE("second-order waves: Stokes harmonic, Madsen's piston correction and the free harmonic in their limits",
+          "[waves]") {
+  const double g = 9.81, height = 0.01;
+  // Deep water (kh = 20): a_2 -> k a^2 / 2 (Stokes), up to terms of order exp(-2 kh) ~ 4e-18
+  {
+    const auto w = waves::linear_wave(0.4, 2.0, g);
+    REQUIRE(w.kh() > 19);
+    const double a = height / 2;
+    CHECK_THAT(waves::stokes_second_harmonic_amplitude(w, height), WithinRel(0.5 * w.wave_number * a * a, 1e-12));
+  }
+  // Shallow water (kh = 0.01): a_2 -> 3 H^2 / (16 k^2 h^3) and X_2 -> a_2 / (2 kh) = 3 H^2 / (32 k^3 h^4); the
+  // series of the closed forms give relative corrections +2 (kh)^2 / 3 and -2 (kh)^2 / 3 = 6.7e-5: tolerance 1e-4.
+  // In that limit the free wave a first-order paddle sheds cancels the bound one at the paddle: a_2f -> a_2.
+  {
+    const double depth = 0.01;
+    const double omega = std::sqrt(g * 1.0 * std::tanh(0.01));  // k = 1 1/m on the dispersion relation
+    const auto w = waves::linear_wave(2 * pi / omega, depth, g);
+    REQUIRE_THAT(w.kh(), WithinRel(0.01, 1e-3));
+    const double k = w.wave_number, h = depth, H = 1e-4;
+    const double a2 = waves::stokes_second_harmonic_amplitude(w, H);
+    CHECK_THAT(a2, WithinRel(3 * H * H / (16 * k * k * h * h * h), 1e-4));
+    const double x2 = waves::madsen_piston_second_harmonic(w, H);
+    CHECK_THAT(x2, WithinRel(3 * H * H / (32 * k * k * k * h * h * h * h), 1e-4));
+    const auto free = waves::free_second_harmonic(w, H);
+    CHECK_THAT(free.amplitude, WithinRel(a2, 2e-4));  // both ends carry an O((kh)^2) correction
+    CHECK_THAT(waves::piston_wave_elevation(w, H, false, 0.0, 0.3),
+               WithinAbs(0.5 * H * std::cos(-w.angular_frequency * 0.3), 2e-4 * a2));
+  }
+  // The validation wave (h = 0.16 m, T = 1.4286 s, H = 0.028 m): U = 19.6 below Madsen's 8 pi^2 / 3 = 26.3, where
+  // a_2 < a / 4 (no secondary crest in the trough); the correction is 7 % of the first-order excursion.
+  const auto w = waves::linear_wave(1.4286, 0.16, g);
+  const double H = 0.028;
+  CHECK_THAT(waves::ursell_number(w, H), WithinAbs(19.65, 0.01));
+  CHECK(waves::ursell_number(w, H) < waves::second_order_ursell_limit<double>());
+  CHECK_THAT(waves::second_order_ursell_limit<double>(), WithinRel(26.319, 1e-4));
+  const double a2 = waves::stokes_second_harmonic_amplitude(w, H);
+  CHECK(a2 < H / 8);
+  CHECK_THAT(a2, WithinAbs(0.003276, 1e-6));
+  const waves::Wavemaker<double> linear({});
+  const double x2 = waves::madsen_piston_second_harmonic(w, H);
+  CHECK_THAT(x2 / (0.5 * linear.stroke()), WithinAbs(0.0705, 0.0005));
+  // Zero-crossing heights of second-order theory: H everywhere with the corrected paddle; beating with the beat
+  // length 2 pi / |k_2 - 2k| (2.55 L here) with the first-order paddle, between H at the paddle and about 1.09 H.
+  const auto free = waves::free_second_harmonic(w, H);
+  CHECK_THAT(free.beat_length / w.wavelength, WithinAbs(2.545, 0.001));
+  auto crest_to_trough = [&](bool corrected, double x) {
+    double hi = -1, lo = 1;
+    for (int i = 0; i < 4000; ++i) {
+      const double e = waves::piston_wave_elevation(w, H, corrected, x, w.period * i / 4000.0);
+      hi = std::max(hi, e), lo = std::min(lo, e);
+    }
+    return hi - lo;
+  };
+  for (double x : {0.0, 0.7, 1.9, 3.2}) CHECK_THAT(crest_to_trough(true, x), WithinRel(H, 1e-5));
+  CHECK_THAT(crest_to_trough(false, 0.3), WithinRel(crest_to_trough(false, 0.3 + free.beat_length), 1e-5));
+  double largest = 0;
+  for (int i = 0; i < 50; ++i) largest = std::max(largest, crest_to_trough(false, free.beat_length * i / 50.0));
+  CHECK_THAT(largest / H, WithinAbs(1.09, 0.01));
+  CHECK_THROWS_AS(waves::stokes_second_harmonic_amplitude(w, -1.0), InputError);
+  CHECK_THROWS_AS(waves::madsen_piston_second_harmonic(w, 0.0), InputError);
+}
+
+TEST_CASE("wavemaker: second-order piston signal (Madsen 1971)", "[waves]") {
+  waves::WavemakerParameters<double> p;
+  p.order = 2;
+  const waves::Wavemaker<double> second(p);
+  const waves::Wavemaker<double> first({});
+  const double x2 = waves::madsen_piston_second_harmonic(second.wave(), p.wave_height);
+  CHECK(second.second_harmonic() == x2);
+  CHECK(first.second_harmonic() == 0.0);
+  CHECK(second.stroke() == first.stroke());
+  // after the ramp: X = (S/2) sin(wt) + X_2 sin(2wt)
+  const double w = second.wave().angular_frequency;
+  for (double t : {3.0, 4.1, 7.77}) {
+    CHECK_THAT(second.displacement(t),
+               WithinAbs(0.5 * second.stroke() * std::sin(w * t) + x2 * std::sin(2 * w * t), 1e-15));
+  }
+  CHECK(second.displacement(0.0) == 0.0);
+  CHECK(second.velocity(0.0) == 0.0);
+  for (double t : {0.1, 0.7, 1.5, 2.8, 2.9, 5.0}) {  // during and after the ramp
+    const double dt = 1e-5;
+    const double fd = (second.displacement(t + dt) - second.displacement(t - dt)) / (2 * dt);
+    CHECK_THAT(second.velocity(t), WithinAbs(fd, 1e-8));
+  }
+  p.order = 3;
+  CHECK_THROWS_AS(waves::Wavemaker<double>(p), InputError);
+  p.order = 2;
+  p.paddle = waves::PaddleType::flap;
+  CHECK_THROWS_AS(waves::Wavemaker<double>(p), InputError);
 }
 
 TEST_CASE("zero-crossing analysis of synthetic records", "[waves][analysis]") {

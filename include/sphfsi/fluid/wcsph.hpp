@@ -70,6 +70,10 @@ struct FluidParameters {
   T kinematic_viscosity{T(0)};                       ///< laminar viscosity nu, m^2/s (0: none)
   WallModel walls{WallModel::dynamic};
   RepulsiveForceParameters<T> repulsive{};  ///< used when walls == repulsive
+  /// Artificial viscosity between fluid and dynamic wall particles too (true, the usual DBC practice: a no-slip-like
+  /// viscous wall); false: fluid-fluid pairs only, so the walls act on the fluid by pressure alone (a wave flume's
+  /// bed then has no viscous Stokes layer of the artificial viscosity nu = alpha h c0 / 8; docs/flume.md).
+  bool wall_artificial_viscosity{true};
   /// Kernel-gradient correction of the pressure gradient (none: the symmetric, momentum-conserving form).
   GradientCorrection gradient_correction{GradientCorrection::none};
   /// Fluid pressure floor, Pa (-inf: none). 0 stops spray clusters from collapsing under negative pressure
@@ -354,7 +358,8 @@ class WcsphFluid {
       drho += mass[b] * continuity;
       T drho_b = ma * continuity;
       const T rho_b = rho[b];
-      const T pi_ab = vr < T(0) ? -alpha * (ca + c[b]) * mu / (rho_a + rho_b) : T(0);
+      const bool viscous_pair = (fluid_a && fluid_b) || params_.wall_artificial_viscosity;
+      const T pi_ab = vr < T(0) && viscous_pair ? -alpha * (ca + c[b]) * mu / (rho_a + rho_b) : T(0);
       const T pb = pressure_term[b];
       const T force = pa + pb + pi_ab;
       const T laminar =

@@ -169,12 +169,13 @@ FluidParameters<2, T> wave_flume_fluid(const WaveFlumeGeometry<T>& g) {
   return f;
 }
 
-/// Default gauge positions: one, two, ... n wavelengths from the paddle.
+/// Default gauge positions: one, two, ... n spacings from the paddle (spacing in wavelengths, default one).
 template <Real T>
-std::vector<T> wave_flume_gauges(const WaveFlumeGeometry<T>& g, int count) {
+std::vector<T> wave_flume_gauges(const WaveFlumeGeometry<T>& g, int count, T spacing = T(1)) {
   require_in_range("wave_flume_gauges count", count, 1, 1000);
+  require_in_range("wave_flume_gauges spacing (wavelengths)", spacing, T(0.01), g.length_wavelengths);
   std::vector<T> x;
-  for (int i = 1; i <= count; ++i) x.push_back(T(i) * g.wavelength());
+  for (int i = 1; i <= count; ++i) x.push_back(T(i) * spacing * g.wavelength());
   return x;
 }
 

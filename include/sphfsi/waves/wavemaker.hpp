@@ -9,12 +9,16 @@
 //   piston:  every paddle particle translates by X(t)                  -> Simulation::set_wall_motion
 //   flap:    paddle particles rotate about the hinge (x_h, z_h) by theta(t) = atan(X(t) / (h - z_h)),
 //            positive theta moving the top towards +x                   -> Simulation::set_wall_kinematics
+// Second-order piston generation (WavemakerParameters::order = 2; Madsen 1971, waves/second_order.hpp) adds
+// r(t)^2 X_2 sin(2 omega t), the motion that keeps the paddle from shedding a free second harmonic; the ramp
+// enters squared because X_2 is quadratic in the wave amplitude.
 #pragma once
 
 #include <sphfsi/core/error.hpp>
 #include <sphfsi/core/types.hpp>
 #include <sphfsi/integrators/simulation.hpp>
 #include <sphfsi/waves/linear_theory.hpp>
+#include <sphfsi/waves/second_order.hpp>
 
 #include <cmath>
 #include <numbers>
@@ -33,6 +37,7 @@ struct WavemakerParameters {
   T depth{T(0.16)};         ///< still-water depth h in front of the paddle, m
   T gravity{T(9.81)};       ///< m/s^2
   T ramp_periods{T(2)};     ///< length of the start-up ramp, in periods (0: none), [0, 100]
+  int order{1};             ///< 1: Biesel's first-order signal; 2: with Madsen's (1971) correction (piston only)
 
   void validate() const {
     require_positive("WavemakerParameters::wave_height (m)", wave_height);
@@ -40,6 +45,10 @@ struct WavemakerParameters {
     require_positive("WavemakerParameters::depth (m)", depth);
     require_positive("WavemakerParameters::gravity (m/s^2)", gravity);
     require_in_range("WavemakerParameters::ramp_periods", ramp_periods, T(0), T(100));
+    require_in_range("WavemakerParameters::order", order, 1, 2);
+    if (order == 2 && paddle != PaddleType::piston)
+      throw InputError(
+          "WavemakerParameters::order = 2 is implemented for the piston paddle only (valid for a flap: 1)");
   }
 };
 
@@ -58,12 +67,15 @@ class Wavemaker {
           fmt::format("Wavemaker: the stroke S = {} m needed for H = {} m exceeds the depth h = {} m: "
                       "valid wave heights are below {} m for this period and depth",
                       stroke_, params_.wave_height, params_.depth, ratio * params_.depth));
+    if (params_.order == 2) second_harmonic_ = madsen_piston_second_harmonic(wave_, params_.wave_height);
   }
 
   const WavemakerParameters<T>& parameters() const noexcept { return params_; }
   const LinearWave<T>& wave() const noexcept { return wave_; }
   /// Full stroke S (peak to peak excursion at the still-water level), m.
   T stroke() const noexcept { return stroke_; }
+  /// Amplitude X_2 of the second-harmonic excursion (Madsen 1971), m; 0 for a first-order wavemaker.
+  T second_harmonic() const noexcept { return second_harmonic_; }
   /// Duration of the start-up ramp, s.
   T ramp_time() const noexcept { return params_.ramp_periods * params_.period; }
 
@@ -79,14 +91,16 @@ class Wavemaker {
   /// Horizontal excursion X(t) of the paddle at the still-water level, m.
   T displacement(T t) const {
     const auto [r, dr] = ramp(t);
-    return T(0.5) * stroke_ * r * std::sin(wave_.angular_frequency * t);
+    const T w = wave_.angular_frequency;
+    return T(0.5) * stroke_ * r * std::sin(w * t) + second_harmonic_ * r * r * std::sin(T(2) * w * t);
   }
 
   /// dX/dt, m/s.
   T velocity(T t) const {
     const auto [r, dr] = ramp(t);
     const T w = wave_.angular_frequency;
-    return T(0.5) * stroke_ * (dr * std::sin(w * t) + r * w * std::cos(w * t));
+    return T(0.5) * stroke_ * (dr * std::sin(w * t) + r * w * std::cos(w * t)) +
+           second_harmonic_ * r * (T(2) * dr * std::sin(T(2) * w * t) + T(2) * r * w * std::cos(T(2) * w * t));
   }
 
   /// Rigid horizontal translation for Simulation::set_wall_motion (piston paddles).
@@ -143,6 +157,7 @@ class Wavemaker {
   WavemakerParameters<T> params_;
   LinearWave<T> wave_{};
   T stroke_{0};
+  T second_harmonic_{0};  // X_2, m
 };
 
 }  // namespace sphfsi::waves
