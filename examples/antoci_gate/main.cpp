@@ -44,14 +44,22 @@ struct Options {
   Scalar max_rms_dx = 1, max_rms_dy = 1;  // m; the exit status is non-zero above these
   Scalar checkpoint_interval = 0;         // s of simulated time between checkpoints (0: none)
   bool resume = false;                    // continue from <output>/antoci_gate.chk
+  bool gray_monaghan_swift = false;       // --solid ul-gms: the paper's eq. 13 sums (GMS 2001) instead of corrected
 };
 
 // The gate's solid model with gravity and a stretch limit (a gate stretched 3x has broken: stop with a diagnosis).
 template <class Solid>
-Solid make_gate(const System& system, const scenes::AntociGate<Scalar>& scene, std::int32_t body) {
+Solid make_gate(const System& system, const scenes::AntociGate<Scalar>& scene, std::int32_t body,
+                bool gray_monaghan_swift) {
   typename Solid::Parameters params;
   params.gravity = Vec<2, Scalar>(0, -scene.gravity);
   params.stretch_limit = 3;
+  if constexpr (std::is_same_v<Solid, UpdatedLagrangian>) {
+    if (gray_monaghan_swift) {  // the reference paper's eq. 13 as published: current-configuration sums
+      params.formulation = UpdatedLagrangianFormulation::gray_monaghan_swift;
+      params.artificial_stress = 0.3;  // Monaghan's artificial stress against tensile instability
+    }
+  }
   return Solid(system, body, scene.solid_material(), params);
 }
 
@@ -61,7 +69,7 @@ int run(const Options& opt, const Coupling& coupling) {
   System system(scene.domain(), Tait<Scalar>(scene.fluid_density, scene.fluid_sound_speed));
   const scenes::AntociGateIds ids = scenes::build_antoci_gate(system, scene);
 
-  Solid solid = make_gate<Solid>(system, scene, ids.gate_body);
+  Solid solid = make_gate<Solid>(system, scene, ids.gate_body, opt.gray_monaghan_swift);
   // The clamp: the rows above the clamp plane are embedded in the rigid wall. The total-Lagrangian model moves them
   // as the mirror image of the free part (the clamp acts on the wall plane); the other model holds them at rest.
   const Scalar clamp_y = scene.clamp_height();
@@ -74,8 +82,11 @@ int run(const Options& opt, const Coupling& coupling) {
   fmt::print(
       "Antoci gate, {} coupling, {} solid: dp = {:.4g} m (gate {:.4g} m), {} fluid, {} wall, {} solid particles; "
       "c0 fluid {} m/s, solid P-wave {:.3g} m/s\n",
-      Coupling::name, std::is_same_v<Solid, TotalLagrangian> ? "total-Lagrangian" : "updated-Lagrangian", scene.dp(),
-      scene.solid_dp(), system.particles().count(Kind::fluid), system.particles().count(Kind::wall),
+      Coupling::name,
+      std::is_same_v<Solid, TotalLagrangian>
+          ? "total-Lagrangian"
+          : (opt.gray_monaghan_swift ? "updated-Lagrangian (GMS 2001 sums)" : "updated-Lagrangian"),
+      scene.dp(), scene.solid_dp(), system.particles().count(Kind::fluid), system.particles().count(Kind::wall),
       system.particles().count(Kind::solid), scene.fluid_sound_speed, scene.solid_material().p_wave_speed());
 
   std::filesystem::create_directories(opt.output);
@@ -174,7 +185,8 @@ int main(int argc, char** argv) try {
                       "the experiment.");
   Options opt;
   const std::string coupling = cli.get("coupling", "repulsive", "FSI coupling: stress | interface | repulsive");
-  const std::string solid = cli.get("solid", "tl", "solid model: tl (total Lagrangian) | ul (updated Lagrangian)");
+  const std::string solid = cli.get(
+      "solid", "tl", "solid model: tl (total Lagrangian) | ul (updated Lagrangian) | ul-gms (eq. 13 sums of GMS 2001)");
   opt.scene.particles_across =
       cli.get_number("resolution", 80, "particles across the water column A/dp (multiple of 20)");
   opt.scene.solid_refinement = static_cast<int>(
@@ -196,8 +208,9 @@ int main(int argc, char** argv) try {
   if (!cli.finish()) return 0;
   require_positive("--end-time (s)", opt.end_time);
   require_non_negative("--checkpoint-interval (s)", opt.checkpoint_interval);
-  if (solid != "tl" && solid != "ul")
-    throw InputError(fmt::format("--solid = '{}' is invalid: valid values are tl, ul", solid));
+  if (solid != "tl" && solid != "ul" && solid != "ul-gms")
+    throw InputError(fmt::format("--solid = '{}' is invalid: valid values are tl, ul, ul-gms", solid));
+  opt.gray_monaghan_swift = solid == "ul-gms";
   // eps(z) of eq. 22 scales the repulsion with the depth below the still-water level, like hydrostatic pressure.
   RepulsiveForce<Scalar> repulsive;
   repulsive.water_level = opt.scene.column_height;
