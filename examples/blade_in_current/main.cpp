@@ -49,15 +49,16 @@ using Blade = CoupledBody<RepulsiveForce<T>, Rod>;
 using Solver = Simulation<System, SymplecticVerlet, Blade>;
 
 struct Options {
-  T length = 0.05;         // l, m
-  T thickness = 4e-4;      // t, m (HDPE blades of Luhar & Nepf 2011: 0.4 mm)
-  T density = 950;         // rho_s, kg/m^3 (neutral buoyancy does not matter: g = 0)
-  T speed = 0.2;           // U, m/s
-  T particles_along = 15;  // l / dp
-  T nominal_drag = 2.0;    // C_D used to choose E for a target Ca (the measured one is reported)
-  T tow_lengths = 8;       // towing distance after the ramp, in blade lengths
-  T depth_lengths = 3;     // channel depth in blade lengths (blockage l / depth)
-  T average_from = 3;      // the drag is averaged once the blade has moved this many lengths after the ramp
+  T length = 0.05;               // l, m
+  T thickness = 4e-4;            // t, m (HDPE blades of Luhar & Nepf 2011: 0.4 mm)
+  T density = 950;               // rho_s, kg/m^3 (neutral buoyancy does not matter: g = 0)
+  T speed = 0.2;                 // U, m/s
+  T particles_along = 15;        // l / dp
+  T nominal_drag = 2.0;          // C_D used to choose E for a target Ca (the measured one is reported)
+  T tow_lengths = 8;             // towing distance after the ramp, in blade lengths
+  bool velocity_factor = false;  // eps(u_perp) of eq. 23: off, it rectifies the jitter of a light blade
+  T depth_lengths = 3;           // channel depth in blade lengths (blockage l / depth)
+  T average_from = 3;            // the drag is averaged once the blade has moved this many lengths after the ramp
   std::vector<T> cauchy{0, 1, 3, 10, 30, 100, 300, 1000};  // 0: the rigid blade
   std::filesystem::path output = "out/blade_in_current";
 };
@@ -112,6 +113,7 @@ CaseResult run_case(const Options& o, T target_ca) {
   fluid.gravity = V::Zero();
   fluid.artificial_viscosity = T(0.02);
   RepulsiveForce<T> coupling;  // eq. 19 with k = 0.01: no hydrostatic load to balance here
+  coupling.velocity_factor = o.velocity_factor;
   Solver sim(system, fluid, {}, Blade(coupling, std::move(rod)));
   sim.set_expected_flow_speed(2 * U);
 
@@ -169,6 +171,8 @@ int main(int argc, char** argv) try {
   o.thickness = cli.get_number("thickness", o.thickness, "blade thickness t, m");
   o.particles_along = cli.get_number("resolution", o.particles_along, "fluid particles along the blade, l / dp");
   o.tow_lengths = cli.get_number("tow-lengths", o.tow_lengths, "towing distance after the ramp, blade lengths");
+  o.velocity_factor =
+      cli.get("velocity-factor", "off", "eps(u_perp) of eq. 23 in the blade coupling: on | off") == "on";
   o.depth_lengths = cli.get_number("depth", o.depth_lengths, "channel depth in blade lengths (blockage 1 / depth)");
   o.average_from = cli.get_number("average-from", o.average_from, "start of the drag average, blade lengths");
   const std::string list = cli.get("cauchy", "0,1,3,10,30,100,300,1000", "target Cauchy numbers (0: rigid blade)");

@@ -38,11 +38,12 @@ namespace sphfsi {
 /// Parameters of the repulsive force, all per boundary.
 template <Real T>
 struct RepulsiveForceParameters {
-  T boundary_spacing{0};  ///< db: distance between neighbouring boundary particles, m
-  T water_level{0};       ///< still-water level z0 used by eps(z); only used when local_depth > 0, m
-  T local_depth{0};       ///< h0 of eq. 22; <= 0 switches the depth scaling off (eps(z) = 1), m
-  int vertical_axis{1};   ///< axis of z (1 in 2D, 2 in 3D)
-  T strength{T(0.01)};    ///< coefficient k of A = k c0^2 / h (eq. 19: 0.01), > 0
+  T boundary_spacing{0};       ///< db: distance between neighbouring boundary particles, m
+  T water_level{0};            ///< still-water level z0 used by eps(z); only used when local_depth > 0, m
+  T local_depth{0};            ///< h0 of eq. 22; <= 0 switches the depth scaling off (eps(z) = 1), m
+  int vertical_axis{1};        ///< axis of z (1 in 2D, 2 in 3D)
+  T strength{T(0.01)};         ///< coefficient k of A = k c0^2 / h (eq. 19: 0.01), > 0
+  bool velocity_factor{true};  ///< eps(u_perp) of eq. 23 (false: eps = eps(z) only; see RepulsiveForce)
 
   /// Throws InputError naming the first parameter out of range.
   void validate() const {
@@ -106,9 +107,9 @@ inline Vec<Dim, T> repulsive_force(const Vec<Dim, T>& dx, const Vec<Dim, T>& dv,
   const T A = params.strength * c0 * c0 / h;                                                     // (19)
   const T R = A * (T(1) - q) / std::sqrt(q);                                                     // (18)
   const T P = T(0.5) * (T(1) + std::cos(std::numbers::pi_v<T> * xi / params.boundary_spacing));  // (20)
-  const T eps =
-      repulsive_depth_factor(elevation, params.local_depth) + repulsive_velocity_factor(dv.dot(n), c0);  // (21)
-  return n * (R * P * eps);                                                                              // (17)
+  const T eps = repulsive_depth_factor(elevation, params.local_depth) +
+                (params.velocity_factor ? repulsive_velocity_factor(dv.dot(n), c0) : T(0));  // (21)
+  return n * (R * P * eps);                                                                  // (17)
 }
 
 }  // namespace sphfsi

@@ -31,6 +31,11 @@ struct RepulsiveForce {
   T sound_speed{0};     ///< c0 used in A = 0.01 c0^2 / h (19) and eps(u) (23); 0: the fluid EOS's c0, m/s
   T range_factor{1};    ///< scales the boundary spacing db used in P(xi) (eq. 20), [0.5, 3]
   T strength{T(0.01)};  ///< k of A = k c0^2 / h (eq. 19: 0.01); see repulsive_strength_for_rest_gap(), > 0
+  /// eps(u_perp) of eq. 23, the push added for fluid approaching the boundary. It is one-sided (zero when the
+  /// fluid recedes), so a light thin blade that jitters under the particle impacts rectifies it into a mean push:
+  /// measured in examples/blade_in_current (docs/thin-blades.md), it raised a flexible blade's drag above the
+  /// rigid blade's. false: eps = eps(z) only.
+  bool velocity_factor{true};
 
   void validate() const {
     require_non_negative("RepulsiveForce::sound_speed (m/s)", sound_speed);
@@ -54,6 +59,7 @@ struct RepulsiveForce {
     params.local_depth = local_depth;
     params.vertical_axis = up;
     params.strength = strength;
+    params.velocity_factor = velocity_factor;
     const T c0 = sound_speed > T(0) ? sound_speed : system.eos().reference_sound_speed();
     for (std::size_t k = 0; k < ids.size(); ++k) {
       if (!surface[k]) continue;
