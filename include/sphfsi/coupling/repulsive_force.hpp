@@ -67,9 +67,9 @@ struct RepulsiveForce {
       const Vector n_s = p.normal[s];
       system.for_each_neighbor(s, [&](std::size_t f, const Vector& dx_sf, T, T h) {
         if (p.kind[f] != Kind::fluid) return;
-        Vector n = n_s;
-        if constexpr (thin)
-          if (dx_sf.dot(n_s) > T(0)) n = -n_s;  // dx_sf = x_s - x_f: the fluid is on the -n_s face
+        // dx_sf = x_s - x_f: a fluid particle with dx_sf . n_s > 0 is on the -n_s face of a thin structure
+        const bool back_face = thin && dx_sf.dot(n_s) > T(0);
+        const Vector n = back_face ? Vector(-n_s) : n_s;
         const Vector a_f = repulsive_force<System::dimension, T>(-dx_sf, p.velocity[f] - p.velocity[s], n, h, c0,
                                                                  p.position[f][up] - water_level, params);
         p.acceleration[f] += a_f;
