@@ -20,7 +20,7 @@ if(TARGET antoci_gate)
 endif()
 
 if(TARGET antoci_gate)
-  # Stop at 0.012 s with a checkpoint at 0.01 s, resume to 0.03 s: the gate-tip record equals the uninterrupted run's.
+  # Stop at 0.012 s with a checkpoint at 0.01 s, resume to 0.02 s: the gate-tip record equals the uninterrupted run's.
   add_test(NAME regression.antoci_gate_resume
            COMMAND ${CMAKE_COMMAND} -DEXE=$<TARGET_FILE:antoci_gate>
                    -DOUT=${CMAKE_CURRENT_BINARY_DIR}/regression/antoci_resume -P ${CMAKE_CURRENT_LIST_DIR}/antoci_resume.cmake)
