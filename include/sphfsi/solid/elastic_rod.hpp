@@ -233,7 +233,8 @@ class ElasticRod {
 
   /// A rigid plane the nodes cannot cross (a bed under a blade that folds over): a node closer than `gap` to the
   /// plane through `point` with unit normal `normal` (pointing to the free side) is put back at `gap` and loses
-  /// the velocity component into the plane (inelastic contact, no friction). Without it the rod meets no walls.
+  /// the velocity component into the plane (inelastic contact, no friction). Nodes whose rest position is closer
+  /// than `gap` (next to a base clamped on the plane) are exempt. Without it the rod meets no walls.
   void set_contact_plane(const Vector& point, const Vector& normal, T gap) {
     require_positive("ElasticRod::set_contact_plane |normal|", normal.norm());
     require_non_negative("ElasticRod::set_contact_plane gap (m)", gap);
@@ -286,7 +287,7 @@ class ElasticRod {
         }
         v_[k] += T(0.5) * h * (a_int_[k] + a_ext_[k] + g);
         x_[k] += h * v_[k];
-        if (has_contact_) {
+        if (has_contact_ && (X_[k] - contact_point_).dot(contact_normal_) >= contact_gap_) {
           const T d = (x_[k] - contact_point_).dot(contact_normal_);
           if (d < contact_gap_) {
             x_[k] += (contact_gap_ - d) * contact_normal_;
