@@ -168,6 +168,31 @@ void check_sub_cycling_equals_single_steps() {
   CHECK(moved > 0);
   CHECK(diff <= 1e-14);  // same arithmetic in the same order: equal to rounding
 }
+/// Starts a plate clamped at x = 0 (length L, spacing dp) in its first Euler-Bernoulli bending mode, kL = 1.875,
+/// with tip speed V_f c0 = 0.01 c0 (Gray et al. 2001), and returns the ids of its tip column (x > L - dp).
+std::vector<std::uint32_t> start_first_bending_mode(SolidSystem<2>& system, double L, double dp) {
+  const double kL = 1.875, k = kL / L;
+  const double M = std::sin(kL) + std::sinh(kL), N = std::cos(kL) + std::cosh(kL);
+  const double Q = 2 * (std::cos(kL) * std::sinh(kL) - std::sin(kL) * std::cosh(kL));
+  auto& p = system.particles();
+  std::vector<std::uint32_t> tip;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const double x = p.position[i].x();
+    if (x > L - dp) tip.push_back(p.id[i]);
+    if (x > 0)
+      p.velocity[i].y() = 0.01 * rubber.sound_speed() *
+                          (M * (std::cos(k * x) - std::cosh(k * x)) - N * (std::sin(k * x) - std::sinh(k * x))) / Q;
+  }
+  return tip;
+}
+
+/// Mean vertical position of the particles `tip` (by id), m.
+double mean_tip_deflection(const SolidSystem<2>& system, const std::vector<std::uint32_t>& tip) {
+  double y = 0;
+  for (auto id : tip) y += system.particles().position[system.particles().slot_of_id(id)].y();
+  return y / double(tip.size());
+}
+
 }  // namespace
 
 TEST_CASE("Solid models: rigid rotation produces no stress", "[solid]") {
@@ -189,21 +214,13 @@ TEST_CASE("TLSPH: energy of the undamped oscillating plate stays within 2 % over
   // hourglass penalty (alpha_hg = 0.1), whose work is bounded by its small share of the stiffness.
   using V = sphfsi::Vec<2, double>;
   auto system = make_system<2>();
-  const double L = 0.2, H = 0.02, dp = H / 4, kL = 1.875, k = kL / L;
+  const double L = 0.2, H = 0.02, dp = H / 4;
   sphfsi::add_solid_block(system, V(-3 * dp, -H / 2), V(L, H / 2), sphfsi::Resolution<double>{.dp = dp}, rubber);
   sphfsi::TotalLagrangianParameters<2, double> params{};
   params.gravity.setZero();
   TL<2> solid(system, 0, rubber, params);
   solid.clamp_where([](const V& X) { return X.x() < 0; });
-  const double M = std::sin(kL) + std::sinh(kL), N = std::cos(kL) + std::cosh(kL);
-  const double Q = 2 * (std::cos(kL) * std::sinh(kL) - std::sin(kL) * std::cosh(kL));
-  auto& p = system.particles();
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    const double x = p.position[i].x();
-    if (x > 0)
-      p.velocity[i].y() = 0.01 * rubber.sound_speed() *
-                          (M * (std::cos(k * x) - std::cosh(k * x)) - N * (std::sin(k * x) - std::sinh(k * x))) / Q;
-  }
+  start_first_bending_mode(system, L, dp);
   solid.compute_rates(system, 0.0);
   const double e0 = solid.kinetic_energy() + solid.strain_energy();
   double lo = 1, hi = 1, t = 0;
@@ -371,22 +388,8 @@ TEST_CASE("TLSPH: oscillating plate period at H/dp = 4 within 4 % of Euler-Berno
   auto params = free_parameters<TL<2>>();
   TL<2> solid(system, 0, rubber, params);
   REQUIRE(solid.clamp_by_reflection(V(0, 0), V(1, 0)) == 12);
-  const double M = std::sin(kL) + std::sinh(kL), N = std::cos(kL) + std::cosh(kL);
-  const double Q = 2 * (std::cos(kL) * std::sinh(kL) - std::sin(kL) * std::cosh(kL));
-  auto& p = system.particles();
-  std::vector<std::uint32_t> tip;
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    const double x = p.position[i].x();
-    if (x > L - dp) tip.push_back(p.id[i]);
-    if (x > 0)
-      p.velocity[i].y() = 0.01 * rubber.sound_speed() *
-                          (M * (std::cos(k * x) - std::cosh(k * x)) - N * (std::sin(k * x) - std::sinh(k * x))) / Q;
-  }
-  auto w = [&]() {
-    double y = 0;
-    for (auto id : tip) y += system.particles().position[system.particles().slot_of_id(id)].y();
-    return y / double(tip.size());
-  };
+  const std::vector<std::uint32_t> tip = start_first_bending_mode(system, L, dp);
+  auto w = [&]() { return mean_tip_deflection(system, tip); };
   const double Ep = rubber.plane_strain_modulus();
   const double period = 2 * std::numbers::pi / std::sqrt(Ep * H * H * k * k * k * k / (12 * rubber.density));
   const double frame = period / 200;
@@ -427,22 +430,8 @@ PlateRun run_plate(typename Model::Parameters params, double L, int n, double pe
   params.gravity.setZero();
   Model solid(system, 0, rubber, params);
   REQUIRE(solid.clamp_by_reflection(V(0, 0), V(1, 0)) == std::size_t(3 * n));
-  const double M = std::sin(kL) + std::sinh(kL), N = std::cos(kL) + std::cosh(kL);
-  const double Q = 2 * (std::cos(kL) * std::sinh(kL) - std::sin(kL) * std::cosh(kL));
-  auto& p = system.particles();
-  std::vector<std::uint32_t> tip;
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    const double x = p.position[i].x();
-    if (x > L - dp) tip.push_back(p.id[i]);
-    if (x > 0)
-      p.velocity[i].y() = 0.01 * rubber.sound_speed() *
-                          (M * (std::cos(k * x) - std::cosh(k * x)) - N * (std::sin(k * x) - std::sinh(k * x))) / Q;
-  }
-  auto w = [&]() {
-    double y = 0;
-    for (auto id : tip) y += system.particles().position[system.particles().slot_of_id(id)].y();
-    return y / double(tip.size());
-  };
+  const std::vector<std::uint32_t> tip = start_first_bending_mode(system, L, dp);
+  auto w = [&]() { return mean_tip_deflection(system, tip); };
   solid.compute_rates(system, 0.0);
   const double e0 = solid.kinetic_energy() + solid.strain_energy();
   const double Ep = rubber.plane_strain_modulus();

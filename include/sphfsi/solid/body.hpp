@@ -173,6 +173,27 @@ class SolidBody {
 
   /// Largest stretch |x_a - x_b| / |X_a - X_b| over the pairs that were neighbours in the reference
   /// configuration (1 when undeformed; a plate that tears shows values well above 1).
+  /// Checkpoint records every solid model starts with: particle count, initialised flag, sub-step count.
+  template <class Writer>
+  void save_checkpoint_header(Writer& w, const std::string& prefix, bool initialised, std::size_t sub_steps) const {
+    w.write(prefix + "particle_count", static_cast<std::uint64_t>(size()));
+    w.write(prefix + "initialised", static_cast<std::uint8_t>(initialised ? 1 : 0));
+    w.write(prefix + "sub_steps", static_cast<std::uint64_t>(sub_steps));
+  }
+  /// Reads the records of save_checkpoint_header; a particle count other than this body's is a reader failure.
+  template <class Reader>
+  void load_checkpoint_header(Reader& r, const std::string& prefix, bool& initialised, std::size_t& sub_steps) const {
+    std::uint64_t count = 0, steps = 0;
+    std::uint8_t flag = 0;
+    r.read(prefix + "particle_count", count);
+    if (count != size())
+      r.fail(fmt::format("solid body {} was saved with {} particles, this scene built {}", body_, count, size()));
+    r.read(prefix + "initialised", flag);
+    r.read(prefix + "sub_steps", steps);
+    initialised = flag != 0;
+    sub_steps = static_cast<std::size_t>(steps);
+  }
+
   T max_stretch() const {
     T s = T(0);
     for (std::size_t a = 0; a < size(); ++a)

@@ -257,9 +257,7 @@ class TotalLagrangianSolid {
   template <class Writer>
   void save_checkpoint(Writer& w) const {
     const auto prefix = fmt::format("total_lagrangian_solid.{}.", body_.body());
-    w.write(prefix + "particle_count", static_cast<std::uint64_t>(body_.size()));
-    w.write(prefix + "initialised", static_cast<std::uint8_t>(initialised_ ? 1 : 0));
-    w.write(prefix + "sub_steps", static_cast<std::uint64_t>(sub_steps_));
+    body_.save_checkpoint_header(w, prefix, initialised_, sub_steps_);
     w.write(prefix + "internal_acceleration", a_int_);
     w.write(prefix + "deformation_gradient", F_);
     w.write(prefix + "first_piola_kirchhoff_stress", P_);
@@ -268,19 +266,10 @@ class TotalLagrangianSolid {
   template <class Reader>
   void load_checkpoint(Reader& r) {
     const auto prefix = fmt::format("total_lagrangian_solid.{}.", body_.body());
-    std::uint64_t count = 0, sub_steps = 0;
-    std::uint8_t initialised = 0;
-    r.read(prefix + "particle_count", count);
-    if (count != body_.size())
-      r.fail(fmt::format("solid body {} was saved with {} particles, this scene built {}", body_.body(), count,
-                         body_.size()));
-    r.read(prefix + "initialised", initialised);
-    r.read(prefix + "sub_steps", sub_steps);
+    body_.load_checkpoint_header(r, prefix, initialised_, sub_steps_);
     r.read_exact(prefix + "internal_acceleration", a_int_, body_.size());
     r.read_exact(prefix + "deformation_gradient", F_, body_.size());
     r.read_exact(prefix + "first_piola_kirchhoff_stress", P_, body_.size());
-    initialised_ = initialised != 0;
-    sub_steps_ = static_cast<std::size_t>(sub_steps);
   }
 
   /// Number of particles whose gradient weights are exact for quadratic fields (the others use Bonet-Lok).

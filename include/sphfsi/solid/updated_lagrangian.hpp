@@ -305,9 +305,7 @@ class UpdatedLagrangianSolid {
   template <class Writer>
   void save_checkpoint(Writer& w) const {
     const auto prefix = fmt::format("updated_lagrangian_solid.{}.", body_.body());
-    w.write(prefix + "particle_count", static_cast<std::uint64_t>(body_.size()));
-    w.write(prefix + "initialised", static_cast<std::uint8_t>(initialised_ ? 1 : 0));
-    w.write(prefix + "sub_steps", static_cast<std::uint64_t>(sub_steps_));
+    body_.save_checkpoint_header(w, prefix, initialised_, sub_steps_);
     w.write(prefix + "density", rho_);
     w.write(prefix + "deviatoric_stress", S_);
     w.write(prefix + "internal_acceleration", a_int_);
@@ -322,13 +320,9 @@ class UpdatedLagrangianSolid {
   void load_checkpoint(Reader& r) {
     const auto prefix = fmt::format("updated_lagrangian_solid.{}.", body_.body());
     const std::size_t n = body_.size();
-    std::uint64_t count = 0, sub_steps = 0;
-    std::uint8_t initialised = 0;
-    r.read(prefix + "particle_count", count);
-    if (count != n)
-      r.fail(fmt::format("solid body {} was saved with {} particles, this scene built {}", body_.body(), count, n));
-    r.read(prefix + "initialised", initialised);
-    r.read(prefix + "sub_steps", sub_steps);
+    bool initialised = false;
+    std::size_t sub_steps = 0;
+    body_.load_checkpoint_header(r, prefix, initialised, sub_steps);
     r.read_exact(prefix + "density", rho_, n);
     r.read_exact(prefix + "deviatoric_stress", S_, n);
     r.read_exact(prefix + "internal_acceleration", a_int_, n);
@@ -340,8 +334,8 @@ class UpdatedLagrangianSolid {
     r.read(prefix + "reference_positions", x_ref);
     r.read(prefix + "reference_volumes", v_ref);
     r.read(prefix + "reference_updates", updates);
-    initialised_ = initialised != 0;
-    sub_steps_ = static_cast<std::size_t>(sub_steps);
+    initialised_ = initialised;
+    sub_steps_ = sub_steps;
     reference_updates_ = static_cast<std::size_t>(updates);
     if (corrected()) {  // the kernel sums of the saved reference configuration (weights recomputed bit-identically)
       if (x_ref.size() != n || v_ref.size() != n)
