@@ -8,6 +8,7 @@
 //                                                             t = 0.1 mm, E = 4.7e8 Pa, rho = 910 kg/m^3) in an
 //                                                             oscillatory current: outer step r rod steps vs 1
 // Every case writes a CSV (--output) for plot.py.
+#include <sphfsi/analysis/elastica.hpp>
 #include <sphfsi/core/particle_system.hpp>
 #include <sphfsi/eos/linear.hpp>
 #include <sphfsi/io/command_line.hpp>
@@ -42,36 +43,7 @@ const T EI = blade.youngs_modulus * section.second_moment(), rhoA = blade.densit
 const T kL = 1.8751040687;
 const T omega1 = kL * kL * std::sqrt(EI / (rhoA * L * L * L * L));
 
-/// Elastica under a dead tip load: theta'' = -alpha cos theta, theta(0) = 0, theta'(1) = 0 (s in units of L),
-/// shooting on theta'(0) by bisection with RK4 (4000 steps). Returns {deflection, shortening} over L.
-std::pair<T, T> elastica_tip_load(T alpha) {
-  const auto shoot = [alpha](T slope) {
-    std::array<T, 4> y{0, slope, 0, 0};
-    const auto rate = [alpha](const std::array<T, 4>& s) {
-      return std::array<T, 4>{s[1], -alpha * std::cos(s[0]), std::cos(s[0]), std::sin(s[0])};
-    };
-    const int steps = 4000;
-    const T h = T(1) / steps;
-    for (int i = 0; i < steps; ++i) {
-      std::array<T, 4> k1 = rate(y), y2, y3, y4;
-      for (int c = 0; c < 4; ++c) y2[c] = y[c] + 0.5 * h * k1[c];
-      const auto k2 = rate(y2);
-      for (int c = 0; c < 4; ++c) y3[c] = y[c] + 0.5 * h * k2[c];
-      const auto k3 = rate(y3);
-      for (int c = 0; c < 4; ++c) y4[c] = y[c] + h * k3[c];
-      const auto k4 = rate(y4);
-      for (int c = 0; c < 4; ++c) y[c] += h / 6 * (k1[c] + 2 * k2[c] + 2 * k3[c] + k4[c]);
-    }
-    return y;
-  };
-  T lo = 0, hi = alpha;
-  for (int i = 0; i < 60; ++i) {
-    const T mid = 0.5 * (lo + hi);
-    (shoot(mid)[1] < 0 ? lo : hi) = mid;
-  }
-  const auto y = shoot(0.5 * (lo + hi));
-  return {y[3], 1 - y[2]};
-}
+using sphfsi::analysis::elastica_tip_load;
 
 void run_static(int nodes, T alpha, fmt::ostream& out) {
   System system = make_system();

@@ -2,6 +2,7 @@
 // times down.
 #pragma once
 
+#include <sphfsi/analysis/elastica.hpp>
 #include <sphfsi/analysis/vegetation_drag.hpp>
 #include <sphfsi/analysis/zero_crossing.hpp>
 #include <sphfsi/boundary/repulsive_force.hpp>

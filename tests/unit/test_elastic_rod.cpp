@@ -1,6 +1,7 @@
 // Tests of the planar discrete elastic rod (solid/elastic_rod.hpp, issue 6): input validation, the elastica
 // under a large tip load, the first bending frequency against Euler-Bernoulli, energy, momentum, rigid motions,
 // sub-cycling with the external force held over the outer step, blade normals and checkpointing.
+#include <sphfsi/analysis/elastica.hpp>
 #include <sphfsi/core/particle_system.hpp>
 #include <sphfsi/eos/linear.hpp>
 #include <sphfsi/io/checkpoint.hpp>
@@ -52,39 +53,7 @@ sphfsi::ElasticRodParameters<double> weightless(double damping = 0) {
   return {.section = section, .gravity = V::Zero(), .damping = damping};
 }
 
-/// Elastica of a cantilever under a dead tip load normal to its clamp, alpha = P L^2 / (E I): with the
-/// deflection angle theta(s), s in units of L, theta'' = -alpha cos(theta), theta(0) = 0, theta'(1) = 0. Shooting
-/// on theta'(0) in (0, alpha] by bisection, RK4 with 4000 steps (error ~ 1e-12). Returns {deflection/L,
-/// (L - x_tip)/L}.
-std::pair<double, double> elastica_tip_load(double alpha) {
-  const auto shoot = [alpha](double slope) {
-    std::array<double, 4> y{0, slope, 0, 0};  // theta, theta', x, deflection
-    const auto rate = [alpha](const std::array<double, 4>& s) {
-      return std::array<double, 4>{s[1], -alpha * std::cos(s[0]), std::cos(s[0]), std::sin(s[0])};
-    };
-    const int steps = 4000;
-    const double h = 1.0 / steps;
-    for (int i = 0; i < steps; ++i) {
-      const auto k1 = rate(y);
-      std::array<double, 4> y2, y3, y4;
-      for (int c = 0; c < 4; ++c) y2[c] = y[c] + 0.5 * h * k1[c];
-      const auto k2 = rate(y2);
-      for (int c = 0; c < 4; ++c) y3[c] = y[c] + 0.5 * h * k2[c];
-      const auto k3 = rate(y3);
-      for (int c = 0; c < 4; ++c) y4[c] = y[c] + h * k3[c];
-      const auto k4 = rate(y4);
-      for (int c = 0; c < 4; ++c) y[c] += h / 6 * (k1[c] + 2 * k2[c] + 2 * k3[c] + k4[c]);
-    }
-    return y;
-  };
-  double lo = 0, hi = alpha;  // theta'(1) < 0 at slope 0, > 0 at slope alpha
-  for (int i = 0; i < 60; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    (shoot(mid)[1] < 0 ? lo : hi) = mid;
-  }
-  const auto y = shoot(0.5 * (lo + hi));
-  return {y[3], 1 - y[2]};
-}
+using sphfsi::analysis::elastica_tip_load;
 
 /// Static tip deflection and shortening (over L) of the rod with `edges` edges under the dead tip load alpha,
 /// by dynamic relaxation (damping 2 omega1) until the largest node speed is below 1e-11 L omega1.
