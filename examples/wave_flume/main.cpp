@@ -61,6 +61,7 @@ int run(const Options& o) {
   g.wave = {s.wave.paddle,     T(s.wave.wave_height),  T(s.wave.period), T(s.wave.depth),
             T(s.wave.gravity), T(s.wave.ramp_periods), s.wave.order};
   g.particles_per_depth = T(s.particles_per_depth);
+  g.smoothing_ratio = T(s.smoothing_ratio);
   g.sound_speed_factor = T(s.sound_speed_factor);
   g.length_wavelengths = T(s.length_wavelengths);
   g.absorber = s.absorber;
@@ -234,6 +235,8 @@ int main(int argc, char** argv) try {
       int(cli.get_number("order", 2, "paddle signal: 1 (Biesel) | 2 (with Madsen's second-order correction)"));
   const std::string paddle = cli.get("paddle", "piston", "paddle: piston | flap");
   g.particles_per_depth = cli.get_number("resolution", 16, "particles over the depth, h/dp");
+  g.smoothing_ratio =
+      cli.get_number("smoothing", g.smoothing_ratio, "smoothing length over particle spacing, h_sph / dp");
   g.sound_speed_factor = cli.get_number("sound-speed", 7, "c0 / sqrt(g h)");
   g.length_wavelengths = cli.get_number("length", 7, "flume length (paddle to end wall), wavelengths");
   const std::string absorber = cli.get("absorber", "damping", "absorber: damping | beach | both");

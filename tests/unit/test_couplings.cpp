@@ -26,29 +26,20 @@ using System = ParticleSystem<2, double, CubicSpline<2>, Tait<double>>;
 using V = Vec<2, double>;
 using Solid = TotalLagrangianSolid<System>;
 
+// The Antoci et al. (2007) rubber of Table 2 (scenes/antoci_gate.hpp).
+ElasticMaterial<double> rubber() { return scenes::AntociGate<double>{}.solid_material(); }
+
 // A free fluid block pressing on a free elastic plate, in vacuum (no walls, no gravity), with random velocities:
 // every force in the scene is an internal pair force, so total momentum must stay constant.
 System make_scene() {
   System system(Domain<2, double>(V(-0.2, -0.2), V(0.3, 0.3)), Tait<double>(1000, 20));
   const Resolution<double> res{0.005, 1.3};
   add_fluid_block(system, V(0, 0), V(0.05, 0.06), res, 0.06, 9.81);  // hydrostatic density: pressure pushes
-  ElasticMaterial<double> rubber;
-  rubber.density = 1100;
-  rubber.youngs_modulus = 1.2e7;
-  rubber.poisson_ratio = 0.4;
-  add_solid_block(system, V(0.05, 0), V(0.07, 0.06), res, rubber, 1);
+  add_solid_block(system, V(0.05, 0), V(0.07, 0.06), res, rubber(), 1);
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(-0.2, 0.2);
   for (auto& v : system.particles().velocity) v = V(u(rng), u(rng));
   return system;
-}
-
-ElasticMaterial<double> rubber() {
-  ElasticMaterial<double> m;
-  m.density = 1100;
-  m.youngs_modulus = 1.2e7;
-  m.poisson_ratio = 0.4;
-  return m;
 }
 
 V momentum(const System& s) {

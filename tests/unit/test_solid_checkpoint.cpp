@@ -10,6 +10,7 @@
 #include <sphfsi/integrators/symplectic.hpp>
 #include <sphfsi/io/checkpoint.hpp>
 #include <sphfsi/kernel/cubic_spline.hpp>
+#include <sphfsi/scenes/antoci_gate.hpp>
 #include <sphfsi/scenes/builders.hpp>
 #include <sphfsi/scenes/solid_builders.hpp>
 #include <sphfsi/solid/total_lagrangian.hpp>
@@ -35,13 +36,8 @@ fs::path checkpoint_dir() {
   return dir;
 }
 
-ElasticMaterial<double> rubber() {
-  ElasticMaterial<double> m;
-  m.density = 1100;
-  m.youngs_modulus = 1.2e7;
-  m.poisson_ratio = 0.4;
-  return m;
-}
+// The Antoci et al. (2007) rubber of Table 2 (scenes/antoci_gate.hpp).
+ElasticMaterial<double> rubber() { return scenes::AntociGate<double>{}.solid_material(); }
 
 // A water column leaning on an elastic plate clamped at its foot, with random velocities so that every state
 // array (stress, viscous terms, neighbour lists) matters for the next step.

@@ -30,7 +30,7 @@ template <Real T>
 struct WaveFlumeGeometry {
   waves::WavemakerParameters<T> wave{};  ///< paddle type, target H, T, h (h is the flume's still-water depth)
   T particles_per_depth{T(16)};          ///< h / dp
-  T smoothing_ratio{T(1.3)};             ///< h_sph / dp
+  T smoothing_ratio{T(2)};               ///< h_sph / dp (1.3 loses waves: docs/flume.md, suspect 8)
   T sound_speed_factor{T(7)};            ///< c0 / sqrt(g h) (hydrostatic compression g h / c0^2 = 2 %)
   T wall_height_ratio{T(1.5)};           ///< height of paddle and end wall over h
   T length_wavelengths{T(7)};            ///< paddle (rest position) to end wall, in wavelengths L
