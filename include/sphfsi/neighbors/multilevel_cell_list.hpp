@@ -1,0 +1,245 @@
+// sphfsi: multi-level (hierarchical) cell lists for particles of several sizes, O(N).
+//
+// The nested hierarchical cell space of Ogarko & Luding 2012 (Comput. Phys. Commun. 183:931, "A fast multilevel
+// algorithm for contact detection of arbitrarily polydisperse objects"; its cost model in Krijgsman, Ogarko &
+// Luding 2014, Comput. Part. Mech. 1:357), applied to SPH pairs with the averaged smoothing length
+// h_ab = (h_a + h_b) / 2, whose interaction radius is R_ab = support h_ab = (r_a + r_b) / 2 (r = support h).
+//
+// Level 0 is the single grid of neighbors/cell_list.hpp, cell edge e_0 = r_max (the largest support radius).
+// Level k halves it k times, e_k = e_0 / 2^k, so that every level-k cell lies inside one level-0 cell, and holds
+// the particles with r in (e_k / 2, e_k] (the finest level also takes anything smaller). A particle a finds its
+// neighbours in every level l by scanning the level-l cells that overlap the box x_a +- max_b R_ab, with b over
+// level l: at most 3 cells per axis on its own and coarser levels (R_ab < e_l + e_l), a few more on finer ones.
+// A fine particle thus scans cells sized for fine particles, and a coarse one finds the fine particles around
+// it without the fine particles' radius being forced up to the coarsest.
+//
+// Storage order: the particles are sorted by level-0 cell (the order of the single grid), and within a level-0
+// cell by level, then by cell of their own level. The particles of each cell of each level are then contiguous
+// (one slot range per cell), and every neighbour of a particle lies in the 3^D level-0 cells around it, so the
+// reach of the pairs visited once (candidate_once_end) is that of the single grid: the per-thread spill buffers of
+// the pair loops (fluid/wcsph.hpp) stay as small as with one grid.
+#pragma once
+
+#include <sphfsi/core/domain.hpp>
+#include <sphfsi/core/error.hpp>
+#include <sphfsi/core/particle_set.hpp>
+#include <sphfsi/core/types.hpp>
+#include <sphfsi/neighbors/cell_list.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+namespace sphfsi {
+
+template <int Dim, Real T>
+class MultilevelCellList {
+ public:
+  using Vector = Vec<Dim, T>;
+
+  /// Most levels: particles more than 2^(max_levels - 1) times smaller than the largest share the finest level.
+  static constexpr int max_levels = 8;
+
+  /// Sorts `particles` by level-0 cell of `coarse` (cell edge: the largest support radius support * h) and, within
+  /// each, by level and cell of their level, then builds the index of every level. Returns the number of levels;
+  /// with 1 (all support radii within a factor 2 of the largest) `coarse` is built as the plain single grid and
+  /// this list must not be queried. Levels are added only while their cells (all fine levels together) number at
+  /// most 16 (N + level-0 cells), which keeps memory and rebuild time O(N): smaller particles then share the
+  /// finest level, which stays correct (its cells are larger than their radius), only slower.
+  int build(ParticleSet<Dim, T>& particles, const Domain<Dim, T>& domain, T support, CellList<Dim, T>& coarse) {
+    require_positive("MultilevelCellList support (smoothing lengths)", support);
+    const std::size_t n = particles.size();
+    T r_max = T(0), r_min = std::numeric_limits<T>::max();
+    for (T h : particles.smoothing_length) {
+      r_max = std::max(r_max, support * h);
+      r_min = std::min(r_min, support * h);
+    }
+    if (!(r_max > T(0))) r_max = support;
+    coarse.set_grid(domain, r_max);
+
+    // How many levels: as many as the smallest radius needs, within the cell budget.
+    std::array<std::int64_t, Dim> coarse_cells{};
+    std::size_t coarse_total = 1;
+    for (int d = 0; d < Dim; ++d) {
+      coarse_cells[d] = coarse.cells_along(d);
+      coarse_total *= static_cast<std::size_t>(coarse_cells[d]);
+    }
+    const std::size_t budget = 16 * (n + coarse_total);
+    int levels = 1;
+    std::size_t fine_total = 0;
+    while (levels < max_levels && r_min * std::ldexp(T(1), levels) <= r_max) {
+      const std::size_t cells = coarse_total << (levels * Dim);
+      if (fine_total + cells > budget || coarse_total + fine_total + cells >= std::numeric_limits<std::uint32_t>::max())
+        break;
+      fine_total += cells;
+      ++levels;
+    }
+    if (levels == 1) {
+      coarse.build(particles, domain, r_max);
+      levels_ = 1;
+      return 1;
+    }
+
+    // The grid of every level and its place in the flat cell index.
+    const bool same_layout = levels == levels_ && coarse_cells == level_[0].cells;
+    std::size_t offset = 0;
+    for (int l = 0; l < levels; ++l) {
+      Level& level = level_[l];
+      level.offset = offset;
+      std::size_t total = 1;
+      for (int d = 0; d < Dim; ++d) {
+        level.cells[d] = coarse_cells[d] << l;
+        total *= static_cast<std::size_t>(level.cells[d]);
+      }
+      offset += total;
+      level.scale = std::ldexp(T(1), l);
+      level.radius = T(0);
+      level.count = 0;
+    }
+    levels_ = levels;
+    coarse_cell_size_ = r_max;
+    inverse_coarse_cell_size_ = T(1) / r_max;
+
+    // Level, grid coordinates and cell of every particle, in storage order.
+    key_.resize(n);
+    scratch_coordinates_.resize(n);
+    scratch_radius_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const T r = support * particles.smoothing_length[i];
+      int l = 0;
+      while (l + 1 < levels && r * std::ldexp(T(1), l + 1) <= r_max) ++l;
+      const Vector y = coarse.grid_coordinates(particles.position[i]);
+      key_[i] = cell_of(y, l);
+      scratch_coordinates_[i] = y;
+      scratch_radius_[i] = r;
+      level_[l].radius = std::max(level_[l].radius, r);
+      ++level_[l].count;
+    }
+    // Sort: level-0 cell first (CellList, stable), then (level, cell of the level) within it.
+    const std::uint32_t* key = key_.data();
+    coarse.sort(particles, [key](std::uint32_t* first, std::uint32_t* last) {
+      std::sort(first, last,
+                [key](std::uint32_t a, std::uint32_t b) { return key[a] < key[b] || (key[a] == key[b] && a < b); });
+    });
+
+    // Per-slot state in the new order; the slot range of every cell.
+    if (same_layout) {
+      for (std::uint32_t g : cell_) range_[2 * std::size_t(g)] = range_[2 * std::size_t(g) + 1] = 0;
+    } else {
+      range_.assign(2 * offset, 0);
+    }
+    const auto& order = coarse.order();
+    cell_.resize(n);
+    coordinates_.resize(n);
+    radius_.resize(n);
+    for (std::size_t s = 0; s < n; ++s) {
+      const std::uint32_t from = order[s];
+      const std::uint32_t g = key_[from];
+      cell_[s] = g;
+      coordinates_[s] = scratch_coordinates_[from];
+      radius_[s] = scratch_radius_[from];
+      if (range_[2 * std::size_t(g) + 1] == 0) range_[2 * std::size_t(g)] = static_cast<std::uint32_t>(s);
+      range_[2 * std::size_t(g) + 1] = static_cast<std::uint32_t>(s + 1);
+    }
+    return levels;
+  }
+
+  /// Calls f(j) for every particle j (i itself included) in the cells of every level that can hold a neighbour of
+  /// slot i: |x_i - x_j| < (r_i + r_j) / 2 implies that j is visited.
+  template <class F>
+  void for_each_candidate(std::size_t i, F&& f) const {
+    visit(i, 0, f);
+  }
+
+  /// Calls f(j) like for_each_candidate, but only for j > i: over all i every pair of candidates is visited exactly
+  /// once. Every j lies in the 3^D level-0 cells around i, so below CellList::candidate_once_end(i).
+  template <class F>
+  void for_each_candidate_once(std::size_t i, F&& f) const {
+    visit(i, i + 1, f);
+  }
+
+  /// Number of levels of the last build (1: single grid).
+  int levels() const noexcept { return levels_; }
+  /// Cell edge of level l, m.
+  T cell_size(int l) const noexcept { return std::ldexp(coarse_cell_size_, -l); }
+  /// Particles in level l at the last build.
+  std::size_t level_count(int l) const noexcept { return level_[l].count; }
+
+ private:
+  struct Level {
+    std::array<std::int64_t, Dim> cells{};  // cells along each axis (level-0 cells times 2^l)
+    std::size_t offset = 0;                 // first cell in the flat index
+    T scale{1};                             // 2^l: level-0 cell units to level-l cell units
+    T radius{0};                            // largest support radius of the level's particles, m
+    std::size_t count = 0;                  // particles in the level
+  };
+
+  // Flat index of the level-l cell holding grid coordinates y (in level-0 cell units; scaling by 2^l is exact,
+  // so the level-l cell lies inside the level-0 cell floor(y) of the CellList).
+  std::uint32_t cell_of(const Vector& y, int l) const {
+    const Level& level = level_[l];
+    const T scale = level.scale;
+    std::int64_t index = 0, stride = 1;
+    for (int d = 0; d < Dim; ++d) {
+      const auto c =
+          std::clamp<std::int64_t>(static_cast<std::int64_t>(std::floor(y[d] * scale)), 0, level.cells[d] - 1);
+      index += c * stride;
+      stride *= level.cells[d];
+    }
+    return static_cast<std::uint32_t>(level.offset + static_cast<std::size_t>(index));
+  }
+
+  // Calls f(j) for the slots j >= first of every cell, on every level, overlapping the box y_i +- reach: reach is
+  // the largest pair radius (r_i + r_l) / 2 with that level, in level-0 cell units, plus a few ulps of the
+  // coordinates (the rounding of x -> y must not drop a cell).
+  template <class F>
+  void visit(std::size_t i, std::size_t first, F& f) const {
+    const Vector y = coordinates_[i];
+    const T ri = radius_[i];
+    const T slack = T(8) * std::numeric_limits<T>::epsilon() * (y.maxCoeff() + T(2));
+    for (int l = 0; l < levels_; ++l) {
+      const Level& level = level_[l];
+      if (level.count == 0) continue;
+      const T reach = T(0.5) * (ri + level.radius) * inverse_coarse_cell_size_ + slack;
+      const T scale = level.scale;
+      std::array<std::int64_t, Dim> lo{}, hi{};
+      for (int d = 0; d < Dim; ++d) {
+        lo[d] = std::clamp<std::int64_t>(static_cast<std::int64_t>(std::floor((y[d] - reach) * scale)), 0,
+                                         level.cells[d] - 1);
+        hi[d] = std::clamp<std::int64_t>(static_cast<std::int64_t>(std::floor((y[d] + reach) * scale)), 0,
+                                         level.cells[d] - 1);
+      }
+      const auto row = [&](std::size_t base) {
+        for (std::int64_t cx = lo[0]; cx <= hi[0]; ++cx) {
+          const std::size_t g = base + static_cast<std::size_t>(cx);
+          const std::size_t end = range_[2 * g + 1];
+          for (std::size_t j = std::max<std::size_t>(range_[2 * g], first); j < end; ++j) f(j);
+        }
+      };
+      if constexpr (Dim == 2) {
+        for (std::int64_t cy = lo[1]; cy <= hi[1]; ++cy)
+          row(level.offset + static_cast<std::size_t>(cy * level.cells[0]));
+      } else {
+        for (std::int64_t cz = lo[2]; cz <= hi[2]; ++cz)
+          for (std::int64_t cy = lo[1]; cy <= hi[1]; ++cy)
+            row(level.offset + static_cast<std::size_t>((cz * level.cells[1] + cy) * level.cells[0]));
+      }
+    }
+  }
+
+  std::array<Level, max_levels> level_{};
+  int levels_ = 1;
+  T coarse_cell_size_{1}, inverse_coarse_cell_size_{1};  // level-0 cell edge r_max, m, and its inverse, 1/m
+  std::vector<std::uint32_t> range_;                     // [begin, end) slots of every cell of every level
+  std::vector<std::uint32_t> cell_;                      // flat cell of every slot
+  std::vector<Vector> coordinates_;                      // grid coordinates of every slot at the last build
+  std::vector<T> radius_;                                // support radius of every slot, m
+  std::vector<std::uint32_t> key_;                       // build scratch, by storage order before the sort
+  std::vector<Vector> scratch_coordinates_;
+  std::vector<T> scratch_radius_;
+};
+
+}  // namespace sphfsi
