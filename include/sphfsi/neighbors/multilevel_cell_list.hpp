@@ -98,6 +98,8 @@ class MultilevelCellList {
       level.scale = std::ldexp(T(1), l);
       level.radius = T(0);
       level.count = 0;
+      level.first.fill(std::numeric_limits<std::int64_t>::max());
+      level.last.fill(-1);
     }
     levels_ = levels;
     coarse_cell_size_ = r_max;
@@ -110,19 +112,27 @@ class MultilevelCellList {
     for (std::size_t i = 0; i < n; ++i) {
       const T r = support * particles.smoothing_length[i];
       int l = 0;
-      while (l + 1 < levels && r * std::ldexp(T(1), l + 1) <= r_max) ++l;
+      while (l + 1 < levels && r * level_[l + 1].scale <= r_max) ++l;
       const Vector y = coarse.grid_coordinates(particles.position[i]);
-      key_[i] = cell_of(y, l);
+      Level& level = level_[l];
+      std::array<std::int64_t, Dim> c;
+      key_[i] = cell_of(y, l, c);
       scratch_coordinates_[i] = y;
       scratch_radius_[i] = r;
-      level_[l].radius = std::max(level_[l].radius, r);
-      ++level_[l].count;
+      level.radius = std::max(level.radius, r);
+      ++level.count;
+      for (int d = 0; d < Dim; ++d) {
+        level.first[d] = std::min(level.first[d], c[d]);
+        level.last[d] = std::max(level.last[d], c[d]);
+      }
     }
     // Sort: level-0 cell first (CellList, stable), then (level, cell of the level) within it.
     const std::uint32_t* key = key_.data();
     coarse.sort(particles, [key](std::uint32_t* first, std::uint32_t* last) {
-      std::sort(first, last,
-                [key](std::uint32_t a, std::uint32_t b) { return key[a] < key[b] || (key[a] == key[b] && a < b); });
+      const auto before = [key](std::uint32_t a, std::uint32_t b) {
+        return key[a] < key[b] || (key[a] == key[b] && a < b);
+      };
+      if (!std::is_sorted(first, last, before)) std::sort(first, last, before);
     });
 
     // Per-slot state in the new order; the slot range of every cell.
@@ -151,14 +161,14 @@ class MultilevelCellList {
   /// slot i: |x_i - x_j| < (r_i + r_j) / 2 implies that j is visited.
   template <class F>
   void for_each_candidate(std::size_t i, F&& f) const {
-    visit(i, 0, f);
+    visit<false>(i, f);
   }
 
   /// Calls f(j) like for_each_candidate, but only for j > i: over all i every pair of candidates is visited exactly
   /// once. Every j lies in the 3^D level-0 cells around i, so below CellList::candidate_once_end(i).
   template <class F>
   void for_each_candidate_once(std::size_t i, F&& f) const {
-    visit(i, i + 1, f);
+    visit<true>(i, f);
   }
 
   /// Number of levels of the last build (1: single grid).
@@ -170,50 +180,66 @@ class MultilevelCellList {
 
  private:
   struct Level {
-    std::array<std::int64_t, Dim> cells{};  // cells along each axis (level-0 cells times 2^l)
-    std::size_t offset = 0;                 // first cell in the flat index
-    T scale{1};                             // 2^l: level-0 cell units to level-l cell units
-    T radius{0};                            // largest support radius of the level's particles, m
-    std::size_t count = 0;                  // particles in the level
+    std::array<std::int64_t, Dim> cells{};          // cells along each axis (level-0 cells times 2^l)
+    std::size_t offset = 0;                         // first cell in the flat index
+    T scale{1};                                     // 2^l: level-0 cell units to level-l cell units
+    T radius{0};                                    // largest support radius of the level's particles, m
+    std::size_t count = 0;                          // particles in the level
+    std::array<std::int64_t, Dim> first{}, last{};  // the cells the level's particles occupy: a bounding box
   };
 
   // Flat index of the level-l cell holding grid coordinates y (in level-0 cell units; scaling by 2^l is exact,
   // so the level-l cell lies inside the level-0 cell floor(y) of the CellList).
-  std::uint32_t cell_of(const Vector& y, int l) const {
+  // Also returns the cell's coordinates along each axis in c.
+  std::uint32_t cell_of(const Vector& y, int l, std::array<std::int64_t, Dim>& c) const {
     const Level& level = level_[l];
     const T scale = level.scale;
     std::int64_t index = 0, stride = 1;
     for (int d = 0; d < Dim; ++d) {
-      const auto c =
-          std::clamp<std::int64_t>(static_cast<std::int64_t>(std::floor(y[d] * scale)), 0, level.cells[d] - 1);
-      index += c * stride;
+      c[d] = std::clamp<std::int64_t>(static_cast<std::int64_t>(std::floor(y[d] * scale)), 0, level.cells[d] - 1);
+      index += c[d] * stride;
       stride *= level.cells[d];
     }
     return static_cast<std::uint32_t>(level.offset + static_cast<std::size_t>(index));
   }
 
-  // Calls f(j) for the slots j >= first of every cell, on every level, overlapping the box y_i +- reach: reach is
-  // the largest pair radius (r_i + r_l) / 2 with that level, in level-0 cell units, plus a few ulps of the
-  // coordinates (the rounding of x -> y must not drop a cell).
-  template <class F>
-  void visit(std::size_t i, std::size_t first, F& f) const {
+  // Calls f(j) for the slots j of every cell, on every level, overlapping the box y_i +- reach: reach is the largest
+  // pair radius (r_i + r_l) / 2 with that level, in level-0 cell units, plus a few ulps of the coordinates (the
+  // rounding of x -> y must not drop a cell). With `once`, only j > i: the slots follow the level-0 cells in
+  // lexicographic order (z, y, x), so the cells whose level-0 cell comes before i's hold only slots < i and are
+  // skipped without being read (a level-l cell c lies in the level-0 cell c / 2^l); in i's own level-0 cell the
+  // ranges are clipped at i + 1.
+  template <bool once, class F>
+  void visit(std::size_t i, F& f) const {
     const Vector y = coordinates_[i];
     const T ri = radius_[i];
     const T slack = T(8) * std::numeric_limits<T>::epsilon() * (y.maxCoeff() + T(2));
+    const std::size_t first = once ? i + 1 : 0;
+    std::array<std::int64_t, Dim> own{};  // i's level-0 cell
+    for (int d = 0; d < Dim; ++d)
+      own[d] = std::clamp<std::int64_t>(static_cast<std::int64_t>(std::floor(y[d])), 0, level_[0].cells[d] - 1);
     for (int l = 0; l < levels_; ++l) {
       const Level& level = level_[l];
       if (level.count == 0) continue;
       const T reach = T(0.5) * (ri + level.radius) * inverse_coarse_cell_size_ + slack;
       const T scale = level.scale;
+      // The box's cells, clipped to the cells the level occupies (a level confined to a region costs nothing to
+      // the particles far from it).
       std::array<std::int64_t, Dim> lo{}, hi{};
+      bool empty = false;
       for (int d = 0; d < Dim; ++d) {
-        lo[d] = std::clamp<std::int64_t>(static_cast<std::int64_t>(std::floor((y[d] - reach) * scale)), 0,
-                                         level.cells[d] - 1);
-        hi[d] = std::clamp<std::int64_t>(static_cast<std::int64_t>(std::floor((y[d] + reach) * scale)), 0,
-                                         level.cells[d] - 1);
+        lo[d] = std::max(static_cast<std::int64_t>(std::floor((y[d] - reach) * scale)), level.first[d]);
+        hi[d] = std::min(static_cast<std::int64_t>(std::floor((y[d] + reach) * scale)), level.last[d]);
+        if constexpr (once) {
+          if (d == Dim - 1) lo[d] = std::max(lo[d], own[d] << l);
+        }
+        empty = empty || lo[d] > hi[d];
       }
-      const auto row = [&](std::size_t base) {
-        for (std::int64_t cx = lo[0]; cx <= hi[0]; ++cx) {
+      if (empty) continue;
+      // One row of cells along x; `own_row`: in the row of level-0 cells of i (skip the cells before i's).
+      const auto row = [&](std::size_t base, bool own_row) {
+        const std::int64_t start = once && own_row ? std::max(lo[0], own[0] << l) : lo[0];
+        for (std::int64_t cx = start; cx <= hi[0]; ++cx) {
           const std::size_t g = base + static_cast<std::size_t>(cx);
           const std::size_t end = range_[2 * g + 1];
           for (std::size_t j = std::max<std::size_t>(range_[2 * g], first); j < end; ++j) f(j);
@@ -221,11 +247,15 @@ class MultilevelCellList {
       };
       if constexpr (Dim == 2) {
         for (std::int64_t cy = lo[1]; cy <= hi[1]; ++cy)
-          row(level.offset + static_cast<std::size_t>(cy * level.cells[0]));
+          row(level.offset + static_cast<std::size_t>(cy * level.cells[0]), (cy >> l) == own[1]);
       } else {
-        for (std::int64_t cz = lo[2]; cz <= hi[2]; ++cz)
-          for (std::int64_t cy = lo[1]; cy <= hi[1]; ++cy)
-            row(level.offset + static_cast<std::size_t>((cz * level.cells[1] + cy) * level.cells[0]));
+        for (std::int64_t cz = lo[2]; cz <= hi[2]; ++cz) {
+          const bool own_layer = (cz >> l) == own[2];
+          const std::int64_t y_start = once && own_layer ? std::max(lo[1], own[1] << l) : lo[1];
+          for (std::int64_t cy = y_start; cy <= hi[1]; ++cy)
+            row(level.offset + static_cast<std::size_t>((cz * level.cells[1] + cy) * level.cells[0]),
+                own_layer && (cy >> l) == own[1]);
+        }
       }
     }
   }
