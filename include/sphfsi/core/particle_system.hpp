@@ -84,13 +84,17 @@ class ParticleSystem {
     if (h_max <= T(0)) h_max = T(1);
     h_uniform_ = h_max;
     constexpr T support = static_cast<T>(Kernel::support);
-    if (uniform_h_) {
+    if (uniform_h_ || !multilevel_enabled_) {
       cells_.build(particles_, domain_, support * h_max);
       multilevel_ = false;
     } else {
       multilevel_ = levels_.build(particles_, domain_, support, cells_) > 1;
     }
   }
+
+  /// Lets update_neighbors() build the multi-level search when the sizes ask for it (the default), or forces the single
+  /// grid (for comparisons: benchmarks/mixed_resolution_search.cpp).
+  void enable_multilevel_search(bool enabled) noexcept { multilevel_enabled_ = enabled; }
 
   /// Whether the last update_neighbors() built the multi-level search (sizes more than a factor 2 apart); if not,
   /// cells() alone is the search.
@@ -126,7 +130,8 @@ class ParticleSystem {
   /// Calls f(j, dx, r, h_ab) for every particle j != i with r = |x_i - x_j| < support * h_ab.
   template <class F>
   void for_each_neighbor(std::size_t i, F&& f) const {
-    if (multilevel_) visit_neighbors(i, f, [this](std::size_t a, auto&& g) { levels_.for_each_candidate(a, g); });
+    if (multilevel_ && levels_.needs_levels(i))
+      visit_neighbors(i, f, [this](std::size_t a, auto&& g) { levels_.for_each_candidate(a, g); });
     else visit_neighbors(i, f, [this](std::size_t a, auto&& g) { cells_.for_each_candidate(a, g); });
   }
 
@@ -135,7 +140,8 @@ class ParticleSystem {
   /// Every j lies in [i + 1, neighbor_once_end(i)).
   template <class F>
   void for_each_neighbor_once(std::size_t i, F&& f) const {
-    if (multilevel_) visit_neighbors(i, f, [this](std::size_t a, auto&& g) { levels_.for_each_candidate_once(a, g); });
+    if (multilevel_ && levels_.needs_levels(i))
+      visit_neighbors(i, f, [this](std::size_t a, auto&& g) { levels_.for_each_candidate_once(a, g); });
     else visit_neighbors(i, f, [this](std::size_t a, auto&& g) { cells_.for_each_candidate_once(a, g); });
   }
 
@@ -179,7 +185,9 @@ class ParticleSystem {
     } else {
       const T hi = particles_.smoothing_length[i];
       const T* hs = particles_.smoothing_length.data();
-      candidates(i, [&](std::size_t j) {
+      // Captured by value: the multi-level search calls this filter out of line, where by-reference captures
+      // would be reloaded for every candidate.
+      candidates(i, [xi, x, hi, hs, i, &f](std::size_t j) {
         const Vector dx = xi - x[j];
         const T r2 = dx.squaredNorm();
         const T h_ab = T(0.5) * (hi + hs[j]);
@@ -201,9 +209,10 @@ class ParticleSystem {
   Particles particles_;
   CellList<Dim, T> cells_;
   MultilevelCellList<Dim, T> levels_;
-  T h_uniform_{1};          // the smoothing length when uniform_h_, m
-  bool uniform_h_{false};   // all smoothing lengths equal at the last update_neighbors()
-  bool multilevel_{false};  // the last update_neighbors() built levels_
+  T h_uniform_{1};                 // the smoothing length when uniform_h_, m
+  bool uniform_h_{false};          // all smoothing lengths equal at the last update_neighbors()
+  bool multilevel_{false};         // the last update_neighbors() built levels_
+  bool multilevel_enabled_{true};  // enable_multilevel_search()
 };
 
 }  // namespace sphfsi

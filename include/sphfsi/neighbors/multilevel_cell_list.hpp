@@ -154,8 +154,36 @@ class MultilevelCellList {
       if (range_[2 * std::size_t(g) + 1] == 0) range_[2 * std::size_t(g)] = static_cast<std::uint32_t>(s);
       range_[2 * std::size_t(g) + 1] = static_cast<std::uint32_t>(s + 1);
     }
+    // Level-0 cells with finer particles in their 3^D neighbourhood; the particles of the other level-0 cells are
+    // searched by the single grid alone (needs_levels()).
+    const std::size_t coarse_cells_total = level_[1].offset;
+    finer_near_.assign(coarse_cells_total, 0);
+    for (std::size_t s = 0; s < n; ++s) {
+      if (cell_[s] < coarse_cells_total) continue;  // a level-0 particle
+      std::array<std::int64_t, Dim> c;
+      const std::uint32_t own = cell_of(coordinates_[s], 0, c);
+      if (finer_near_[own] & 2) continue;  // this cell's neighbourhood is marked already
+      finer_near_[own] |= 2;
+      std::array<std::int64_t, Dim> lo{}, hi{};
+      for (int d = 0; d < Dim; ++d) {
+        lo[d] = std::max<std::int64_t>(c[d] - 1, 0);
+        hi[d] = std::min<std::int64_t>(c[d] + 1, coarse_cells[d] - 1);
+      }
+      for (std::int64_t z = Dim == 3 ? lo[Dim - 1] : 0; z <= (Dim == 3 ? hi[Dim - 1] : 0); ++z)
+        for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
+          for (std::int64_t x = lo[0]; x <= hi[0]; ++x)
+            finer_near_[static_cast<std::size_t>((z * coarse_cells[1] + y) * coarse_cells[0] + x)] |= 1;
+    }
+    needs_levels_.resize(n);
+    for (std::size_t s = 0; s < n; ++s)
+      needs_levels_[s] = cell_[s] >= coarse_cells_total || (finer_near_[cell_[s]] & 1) != 0;
     return levels;
   }
+
+  /// Whether slot i needs the levels: it is finer than level 0, or finer particles lie in the 3^D level-0 cells
+  /// around it. If not, its candidates are exactly those of the level-0 CellList (all of them level-0 particles),
+  /// whose contiguous rows are the cheaper scan: ParticleSystem uses it for those particles.
+  bool needs_levels(std::size_t i) const noexcept { return needs_levels_[i] != 0; }
 
   /// Calls f(j) for every particle j (i itself included) in the cells of every level that can hold a neighbour of
   /// slot i: |x_i - x_j| < (r_i + r_j) / 2 implies that j is visited.
@@ -190,13 +218,20 @@ class MultilevelCellList {
 
   // Flat index of the level-l cell holding grid coordinates y (in level-0 cell units; scaling by 2^l is exact,
   // so the level-l cell lies inside the level-0 cell floor(y) of the CellList).
+  // floor(v) as an integer, equal to static_cast<std::int64_t>(std::floor(v)) for the grid coordinates here (|v| far
+  // below 2^62), without the libm call that std::floor is on baseline x86-64.
+  static std::int64_t floor_index(T v) noexcept {
+    const auto truncated = static_cast<std::int64_t>(v);
+    return truncated - static_cast<std::int64_t>(v < static_cast<T>(truncated));
+  }
+
   // Also returns the cell's coordinates along each axis in c.
   std::uint32_t cell_of(const Vector& y, int l, std::array<std::int64_t, Dim>& c) const {
     const Level& level = level_[l];
     const T scale = level.scale;
     std::int64_t index = 0, stride = 1;
     for (int d = 0; d < Dim; ++d) {
-      c[d] = std::clamp<std::int64_t>(static_cast<std::int64_t>(std::floor(y[d] * scale)), 0, level.cells[d] - 1);
+      c[d] = std::clamp<std::int64_t>(floor_index(y[d] * scale), 0, level.cells[d] - 1);
       index += c[d] * stride;
       stride *= level.cells[d];
     }
@@ -210,14 +245,13 @@ class MultilevelCellList {
   // skipped without being read (a level-l cell c lies in the level-0 cell c / 2^l); in i's own level-0 cell the
   // ranges are clipped at i + 1.
   template <bool once, class F>
-  void visit(std::size_t i, F& f) const {
+  void visit(std::size_t i, F f) const {  // f by value: a local copy whose state the compiler can keep in registers
     const Vector y = coordinates_[i];
     const T ri = radius_[i];
     const T slack = T(8) * std::numeric_limits<T>::epsilon() * (y.maxCoeff() + T(2));
     const std::size_t first = once ? i + 1 : 0;
     std::array<std::int64_t, Dim> own{};  // i's level-0 cell
-    for (int d = 0; d < Dim; ++d)
-      own[d] = std::clamp<std::int64_t>(static_cast<std::int64_t>(std::floor(y[d])), 0, level_[0].cells[d] - 1);
+    for (int d = 0; d < Dim; ++d) own[d] = std::clamp<std::int64_t>(floor_index(y[d]), 0, level_[0].cells[d] - 1);
     for (int l = 0; l < levels_; ++l) {
       const Level& level = level_[l];
       if (level.count == 0) continue;
@@ -228,22 +262,31 @@ class MultilevelCellList {
       std::array<std::int64_t, Dim> lo{}, hi{};
       bool empty = false;
       for (int d = 0; d < Dim; ++d) {
-        lo[d] = std::max(static_cast<std::int64_t>(std::floor((y[d] - reach) * scale)), level.first[d]);
-        hi[d] = std::min(static_cast<std::int64_t>(std::floor((y[d] + reach) * scale)), level.last[d]);
+        lo[d] = std::max(floor_index((y[d] - reach) * scale), level.first[d]);
+        hi[d] = std::min(floor_index((y[d] + reach) * scale), level.last[d]);
         if constexpr (once) {
           if (d == Dim - 1) lo[d] = std::max(lo[d], own[d] << l);
         }
         empty = empty || lo[d] > hi[d];
       }
       if (empty) continue;
-      // One row of cells along x; `own_row`: in the row of level-0 cells of i (skip the cells before i's).
+      // One row of cells along x; `own_row`: in the row of level-0 cells of i (skip the cells before i's). Cells
+      // whose slot ranges follow each other (level-0 cells without finer particles, the level-l cells of a row
+      // inside one level-0 cell) are scanned as one range, as the single grid scans a row of cells.
       const auto row = [&](std::size_t base, bool own_row) {
         const std::int64_t start = once && own_row ? std::max(lo[0], own[0] << l) : lo[0];
+        std::size_t run_begin = 0, run_end = 0;
         for (std::int64_t cx = start; cx <= hi[0]; ++cx) {
           const std::size_t g = base + static_cast<std::size_t>(cx);
-          const std::size_t end = range_[2 * g + 1];
-          for (std::size_t j = std::max<std::size_t>(range_[2 * g], first); j < end; ++j) f(j);
+          const std::size_t begin = range_[2 * g], end = range_[2 * g + 1];
+          if (begin == end) continue;
+          if (begin != run_end) {
+            for (std::size_t j = std::max(run_begin, first); j < run_end; ++j) f(j);
+            run_begin = begin;
+          }
+          run_end = end;
         }
+        for (std::size_t j = std::max(run_begin, first); j < run_end; ++j) f(j);
       };
       if constexpr (Dim == 2) {
         for (std::int64_t cy = lo[1]; cy <= hi[1]; ++cy)
@@ -265,9 +308,11 @@ class MultilevelCellList {
   T coarse_cell_size_{1}, inverse_coarse_cell_size_{1};  // level-0 cell edge r_max, m, and its inverse, 1/m
   std::vector<std::uint32_t> range_;                     // [begin, end) slots of every cell of every level
   std::vector<std::uint32_t> cell_;                      // flat cell of every slot
-  std::vector<Vector> coordinates_;                      // grid coordinates of every slot at the last build
-  std::vector<T> radius_;                                // support radius of every slot, m
-  std::vector<std::uint32_t> key_;                       // build scratch, by storage order before the sort
+  std::vector<std::uint8_t> finer_near_;    // per level-0 cell: 1 finer particles in the 3^D cells, 2 in the cell
+  std::vector<std::uint8_t> needs_levels_;  // per slot: needs_levels()
+  std::vector<Vector> coordinates_;         // grid coordinates of every slot at the last build
+  std::vector<T> radius_;                   // support radius of every slot, m
+  std::vector<std::uint32_t> key_;          // build scratch, by storage order before the sort
   std::vector<Vector> scratch_coordinates_;
   std::vector<T> scratch_radius_;
 };
