@@ -9,7 +9,7 @@
 // Level k halves it k times, e_k = e_0 / 2^k, so that every level-k cell lies inside one level-0 cell, and holds
 // the particles with r in (e_k / 2, e_k] (the finest level also takes anything smaller). A particle a finds its
 // neighbours in every level l by scanning the level-l cells that overlap the box x_a +- max_b R_ab, with b over
-// level l: at most 3 cells per axis on its own and coarser levels (R_ab < e_l + e_l), a few more on finer ones.
+// level l: at most 3 cells per axis on its own and coarser levels (R_ab <= e_l there), a few more on finer ones.
 // A fine particle thus scans cells sized for fine particles, and a coarse one finds the fine particles around
 // it without the fine particles' radius being forced up to the coarsest.
 //
@@ -17,7 +17,8 @@
 // cell by level, then by cell of their own level. The particles of each cell of each level are then contiguous
 // (one slot range per cell), and every neighbour of a particle lies in the 3^D level-0 cells around it, so the
 // reach of the pairs visited once (candidate_once_end) is that of the single grid: the per-thread spill buffers of
-// the pair loops (fluid/wcsph.hpp) stay as small as with one grid.
+// the pair loops (fluid/wcsph.hpp) stay as small as with one grid. A level-0 particle with no finer particle in
+// its 3^D level-0 cells has the single grid's candidates exactly, and keeps its contiguous rows (needs_levels()).
 #pragma once
 
 #include <sphfsi/core/domain.hpp>
