@@ -9,7 +9,10 @@
 //
 // Particles of different sizes: pair interactions use the averaged smoothing length h_ab = (h_a + h_b) / 2
 // (Hernquist & Katz 1989, ApJS 70:419; Monaghan 1992, ARA&A 30:543, sec. 6), so W_ab = W_ba and pair forces
-// cancel exactly; the cell size is the largest support radius in the scene.
+// cancel exactly. With one size the neighbour search is one cell grid (neighbors/cell_list.hpp, cell edge the support
+// radius); with sizes more than a factor 2 apart it is the multi-level search of
+// neighbors/multilevel_cell_list.hpp (one nested grid per size level), which keeps the particle order and the
+// reach of the single grid.
 #pragma once
 
 #include <sphfsi/core/domain.hpp>
@@ -20,6 +23,7 @@
 #include <sphfsi/eos/concepts.hpp>
 #include <sphfsi/kernel/concepts.hpp>
 #include <sphfsi/neighbors/cell_list.hpp>
+#include <sphfsi/neighbors/multilevel_cell_list.hpp>
 
 #include <cmath>
 #include <limits>
@@ -79,8 +83,22 @@ class ParticleSystem {
     uniform_h_ = h_max > T(0) && h_min == h_max;
     if (h_max <= T(0)) h_max = T(1);
     h_uniform_ = h_max;
-    cells_.build(particles_, domain_, static_cast<T>(Kernel::support) * h_max);
+    constexpr T support = static_cast<T>(Kernel::support);
+    if (uniform_h_ || !multilevel_enabled_) {
+      cells_.build(particles_, domain_, support * h_max);
+      multilevel_ = false;
+    } else {
+      multilevel_ = levels_.build(particles_, domain_, support, cells_) > 1;
+    }
   }
+
+  /// Lets update_neighbors() build the multi-level search when the sizes ask for it (the default), or forces the single
+  /// grid (for comparisons: benchmarks/mixed_resolution_search.cpp).
+  void enable_multilevel_search(bool enabled) noexcept { multilevel_enabled_ = enabled; }
+
+  /// Whether the last update_neighbors() built the multi-level search (sizes more than a factor 2 apart); if not,
+  /// cells() alone is the search.
+  bool multilevel_search() const noexcept { return multilevel_; }
 
   /// Whether every particle had the same smoothing length at the last update_neighbors().
   bool uniform_smoothing_length() const noexcept { return uniform_h_; }
@@ -112,7 +130,9 @@ class ParticleSystem {
   /// Calls f(j, dx, r, h_ab) for every particle j != i with r = |x_i - x_j| < support * h_ab.
   template <class F>
   void for_each_neighbor(std::size_t i, F&& f) const {
-    visit_neighbors(i, f, [this](std::size_t a, auto&& g) { cells_.for_each_candidate(a, g); });
+    if (multilevel_ && levels_.needs_levels(i))
+      visit_neighbors(i, f, [this](std::size_t a, auto&& g) { levels_.for_each_candidate(a, g); });
+    else visit_neighbors(i, f, [this](std::size_t a, auto&& g) { cells_.for_each_candidate(a, g); });
   }
 
   /// Calls f(j, dx, r, h_ab) like for_each_neighbor, but only for the neighbours j > i of the half stencil: over
@@ -120,10 +140,13 @@ class ParticleSystem {
   /// Every j lies in [i + 1, neighbor_once_end(i)).
   template <class F>
   void for_each_neighbor_once(std::size_t i, F&& f) const {
-    visit_neighbors(i, f, [this](std::size_t a, auto&& g) { cells_.for_each_candidate_once(a, g); });
+    if (multilevel_ && levels_.needs_levels(i))
+      visit_neighbors(i, f, [this](std::size_t a, auto&& g) { levels_.for_each_candidate_once(a, g); });
+    else visit_neighbors(i, f, [this](std::size_t a, auto&& g) { cells_.for_each_candidate_once(a, g); });
   }
 
-  /// One past the largest slot for_each_neighbor_once(i, f) can visit.
+  /// One past the largest slot for_each_neighbor_once(i, f) can visit. The multi-level search keeps the storage
+  /// order of the level-0 grid cells() and every neighbour in its 3^D cells, so the bound is the same.
   std::size_t neighbor_once_end(std::size_t i) const { return cells_.candidate_once_end(i); }
 
   /// Recomputes pressure and sound speed of fluid and wall particles from their density with the fluid EOS.
@@ -137,7 +160,10 @@ class ParticleSystem {
     });
   }
 
+  /// The level-0 cell grid: cell edge the largest support radius; the particles are stored in its cell order.
   const CellList<Dim, T>& cells() const noexcept { return cells_; }
+  /// The multi-level search (valid while multilevel_search()).
+  const MultilevelCellList<Dim, T>& levels() const noexcept { return levels_; }
 
  private:
   // Filters the candidates that `candidates(i, g)` passes to g by distance and calls f(j, dx, r, h_ab). With one
@@ -159,7 +185,9 @@ class ParticleSystem {
     } else {
       const T hi = particles_.smoothing_length[i];
       const T* hs = particles_.smoothing_length.data();
-      candidates(i, [&](std::size_t j) {
+      // Captured by value: the multi-level search calls this filter out of line, where by-reference captures
+      // would be reloaded for every candidate.
+      candidates(i, [xi, x, hi, hs, i, &f](std::size_t j) {
         const Vector dx = xi - x[j];
         const T r2 = dx.squaredNorm();
         const T h_ab = T(0.5) * (hi + hs[j]);
@@ -180,8 +208,11 @@ class ParticleSystem {
   Kernel kernel_;
   Particles particles_;
   CellList<Dim, T> cells_;
-  T h_uniform_{1};         // the smoothing length when uniform_h_, m
-  bool uniform_h_{false};  // all smoothing lengths equal at the last update_neighbors()
+  MultilevelCellList<Dim, T> levels_;
+  T h_uniform_{1};                 // the smoothing length when uniform_h_, m
+  bool uniform_h_{false};          // all smoothing lengths equal at the last update_neighbors()
+  bool multilevel_{false};         // the last update_neighbors() built levels_
+  bool multilevel_enabled_{true};  // enable_multilevel_search()
 };
 
 }  // namespace sphfsi

@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <type_traits>
 #include <vector>
 
 namespace sphfsi {
@@ -29,6 +30,13 @@ class CellList {
   /// Sorts `particles` into cells of edge >= cell_size covering `domain` and (re)builds the cell index.
   /// Particles outside the domain must have been rejected before (see ParticleSystem::check_state).
   void build(ParticleSet<Dim, T>& particles, const Domain<Dim, T>& domain, T cell_size) {
+    set_grid(domain, cell_size);
+    sort(particles, KeepOrder{});
+  }
+
+  /// Lays the grid of cells of edge >= cell_size over `domain` without sorting anything yet (sort() does): lets a
+  /// caller compute grid_coordinates() of the particles first (neighbors/multilevel_cell_list.hpp).
+  void set_grid(const Domain<Dim, T>& domain, T cell_size) {
     require_positive("CellList cell_size (m)", cell_size);
     lower_ = domain.lower;
     std::size_t total = 1;
@@ -52,7 +60,16 @@ class CellList {
                       cell_size, total, std::numeric_limits<std::uint32_t>::max() - 1));
     inverse_cell_size_ = T(1) / cell_size;
     cell_size_ = cell_size;
+    total_cells_ = total;
+  }
+
+  /// Sorts `particles` into the cells of the grid laid by set_grid() and permutes them into cell order. Within a
+  /// cell, `within_cell(first, last)` may reorder the original particle indices [first, last) (std::uint32_t*),
+  /// which are in storage order when it is called.
+  template <class WithinCell>
+  void sort(ParticleSet<Dim, T>& particles, WithinCell&& within_cell) {
     const std::size_t n = particles.size();
+    const std::size_t total = total_cells_;
     cell_of_.resize(n);
     for (std::size_t i = 0; i < n; ++i) cell_of_[i] = cell_index(particles.position[i]);
     // Counting sort by cell: O(N + cells).
@@ -62,6 +79,11 @@ class CellList {
     order_.resize(n);
     cursor_.assign(cell_start_.begin(), cell_start_.end() - 1);
     for (std::size_t i = 0; i < n; ++i) order_[cursor_[cell_of_[i]]++] = static_cast<std::uint32_t>(i);
+    if constexpr (!std::is_same_v<std::remove_cvref_t<WithinCell>, KeepOrder>) {
+      for (std::size_t c = 0; c < total; ++c)
+        if (cell_start_[c + 1] - cell_start_[c] > 1)
+          within_cell(order_.data() + cell_start_[c], order_.data() + cell_start_[c + 1]);
+    }
     particles.permute(order_);
     // Slots are now in cell order: the cell of slot i is the cell its particle was sorted into.
     for (std::size_t c = 0; c < total; ++c)
@@ -124,12 +146,22 @@ class CellList {
 
   T cell_size() const noexcept { return cell_size_; }
   std::size_t cell_count() const noexcept { return cell_start_.empty() ? 0 : cell_start_.size() - 1; }
+  /// Number of cells along axis d, ghost layers not counted.
+  std::int64_t cells_along(int d) const noexcept { return cells_[d] - 2; }
+  /// Position x in cell units from the domain's lower corner, (x - lower) / cell size: the cell of x along axis d
+  /// is floor of component d (clamped to the grid). Every cell index of this class is computed from it.
+  Vector grid_coordinates(const Vector& x) const { return (x - lower_) * inverse_cell_size_; }
+  /// The permutation of the last sort(): slot s now holds the particle that was in slot order()[s] before.
+  const std::vector<std::uint32_t>& order() const noexcept { return order_; }
 
  private:
+  struct KeepOrder {};  // sort(): no reordering within a cell
+
   std::uint32_t cell_index(const Vector& x) const {
+    const Vector y = grid_coordinates(x);
     std::int64_t index = 0, stride = 1;
     for (int d = 0; d < Dim; ++d) {
-      auto c = static_cast<std::int64_t>(std::floor((x[d] - lower_[d]) * inverse_cell_size_)) + 1;
+      auto c = static_cast<std::int64_t>(std::floor(y[d])) + 1;
       c = std::clamp<std::int64_t>(c, 1, cells_[d] - 2);
       index += c * stride;
       stride *= cells_[d];
@@ -139,6 +171,7 @@ class CellList {
 
   Vector lower_ = Vector::Zero();
   T inverse_cell_size_{1}, cell_size_{1};
+  std::size_t total_cells_{0};
   std::array<std::int32_t, Dim> cells_{};
   std::vector<std::uint32_t> cell_of_, cell_start_, cursor_, order_;
 };
