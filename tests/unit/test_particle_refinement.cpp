@@ -1,0 +1,254 @@
+// Refined fluid regions (issue 9 part 3): particle removal and ids in ParticleSet, splitting and merging
+// (fluid/particle_refinement.hpp, Vacondio et al. 2013), hysteresis at a box edge, bad input, a checkpoint with
+// retired ids, and the hydrostatic tank with a refined band (two levels: dp, dp/2, dp/4).
+#include "../../examples/refined_tank/refined_tank_scene.hpp"
+
+#include <sphfsi/io/checkpoint.hpp>
+#include <sphfsi/kernel/cubic_spline.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <random>
+#include <set>
+
+using namespace sphfsi;
+namespace tank = sphfsi::examples::tank;
+namespace rt = sphfsi::examples::refined_tank;
+
+namespace {
+
+using V2 = Vec<2, double>;
+
+template <int Dim>
+using RefSystem = ParticleSystem<Dim, double, CubicSpline<Dim>, Tait<double>>;
+
+template <int Dim>
+struct Totals {
+  double mass = 0;
+  Vec<Dim, double> momentum = Vec<Dim, double>::Zero();
+  double momentum_scale = 0;  // sum m |v|
+};
+
+template <int Dim>
+Totals<Dim> fluid_totals(const ParticleSet<Dim, double>& p) {
+  Totals<Dim> t;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (p.kind[i] != Kind::fluid) continue;
+    t.mass += p.mass[i];
+    t.momentum += p.mass[i] * p.velocity[i];
+    t.momentum_scale += p.mass[i] * p.velocity[i].norm();
+  }
+  return t;
+}
+
+// Every id unique, below id_capacity(), and slot_of_id(id[i]) == i.
+template <int Dim>
+bool ids_consistent(const ParticleSet<Dim, double>& p) {
+  std::set<std::uint32_t> seen;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (p.id[i] >= p.id_capacity() || !seen.insert(p.id[i]).second) return false;
+    if (p.slot_of_id(p.id[i]) != i || !p.contains_id(p.id[i])) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+TEST_CASE("ParticleSet::remove: swap with the last particle, ids retired and never reused", "[refinement]") {
+  ParticleSet<2, double> p;
+  for (int k = 0; k < 6; ++k) p.add(Kind::fluid, V2(0.1 * k, 0), V2(k, 0), 1000, 1.0 + k, 0.01);
+  p.remove(1);  // particle 5 moves into slot 1
+  CHECK(p.size() == 5);
+  CHECK(p.id[1] == 5);
+  CHECK(p.mass[1] == 6.0);
+  CHECK(p.velocity[1] == V2(5, 0));
+  CHECK(!p.contains_id(1));
+  CHECK(p.slot_of_id(1) == ParticleSet<2, double>::no_slot);
+  p.remove(4);  // the last slot
+  CHECK(p.size() == 4);
+  CHECK(!p.contains_id(4));
+  const std::size_t slot = p.add(Kind::fluid, V2(1, 1), V2(0, 0), 1000, 9.0, 0.01);
+  CHECK(p.id[slot] == 6);  // a new id, not a retired one
+  CHECK(p.id_capacity() == 7);
+  CHECK(ids_consistent(p));
+  // Re-sorting keeps the map.
+  std::vector<std::uint32_t> reverse{4, 3, 2, 1, 0};
+  p.permute(reverse);
+  CHECK(ids_consistent(p));
+  // Rebuilding (a checkpoint read) restores the capacity; without one it is one past the largest id.
+  p.rebuild_slot_of_id(9);
+  CHECK(p.id_capacity() == 9);
+  CHECK(ids_consistent(p));
+  p.rebuild_slot_of_id();
+  CHECK(p.id_capacity() == 7);
+  CHECK_THROWS_WITH(p.rebuild_slot_of_id(3), Catch::Contains("id capacity 3"));
+  CHECK_THROWS_WITH(p.remove(5), Catch::Contains("ParticleSet::remove slot"));
+}
+
+namespace {
+
+// A random fluid set in the unit box: coarse particles (spacing dp) on a jittered lattice, a level-1 box over
+// x < 0.4 where they must split, and in x > 0.7 (beyond the buffer) fine particles of a quarter (2D) or eighth (3D)
+// of the mass that must merge. Random velocities, densities (+-1 %) and rates. One refinement pass must conserve the
+// fluid's mass and momentum to round-off.
+template <int Dim>
+void check_conservation(int cells) {
+  using V = Vec<Dim, double>;
+  RefSystem<Dim> system(Domain<Dim, double>(V::Constant(-0.5), V::Constant(1.5)), Tait<double>(1000, 20));
+  auto& p = system.particles();
+  const double dp = 1.0 / cells, rho0 = 1000;
+  std::mt19937 rng(12345);
+  std::uniform_real_distribution<double> u(-1, 1);
+  auto add = [&](const V& x, double spacing, double jitter) {
+    V xj = x, v;
+    for (int d = 0; d < Dim; ++d) xj[d] += jitter * spacing * u(rng), v[d] = u(rng);
+    const double rho = rho0 * (1 + 0.01 * u(rng));
+    const std::size_t s = p.add(Kind::fluid, xj, v, rho, rho * std::pow(spacing, Dim), 1.3 * spacing);
+    for (int d = 0; d < Dim; ++d) p.acceleration[s][d] = u(rng), p.xsph_velocity[s][d] = 0.01 * u(rng);
+    p.density_rate[s] = u(rng);
+  };
+  const int fine = 2 * cells;
+  std::array<int, 3> i{0, 0, 0};
+  const int total = static_cast<int>(std::pow(fine, Dim));
+  for (int k = 0; k < total; ++k) {
+    int r = k;
+    V x;
+    for (int d = 0; d < Dim; ++d) i[d] = r % fine, r /= fine, x[d] = (i[d] + 0.5) * 0.5 * dp;
+    if (x[0] > 0.7) add(x, 0.5 * dp, 0.1);  // fine, must merge
+    else if (x[0] < 0.7 - dp && (i[0] % 2 == 0) && (i[1] % 2 == 0) && (Dim == 2 || i[2] % 2 == 0)) {
+      V xc = x;
+      for (int d = 0; d < Dim; ++d) xc[d] += 0.25 * dp;
+      add(xc, dp, 0.1);  // coarse
+    }
+  }
+  system.update_neighbors();
+  RefinementParameters<double> params;
+  params.base_spacing = dp;
+  params.buffer_width = 0.1;
+  V upper = V::Constant(1.0);
+  upper[0] = 0.4;
+  ParticleRefinement<RefSystem<Dim>> refinement(system.domain(), {{V::Zero(), upper, 1}}, params);
+  const auto before = fluid_totals(p);
+  const std::size_t n_before = p.size();
+  const auto counts = refinement.refine(system);
+  const auto after = fluid_totals(p);
+  INFO(Dim << "D: " << counts.splits << " splits, " << counts.merges << " merges, " << n_before << " -> " << p.size()
+           << " particles; mass " << before.mass << " -> " << after.mass);
+  CHECK(counts.splits > 0);
+  CHECK(counts.merges > 0);
+  CHECK(p.size() == n_before + counts.created - counts.removed);
+  CHECK(counts.created == counts.splits * ((1u << Dim) - 1));
+  CHECK(counts.removed == counts.merges);
+  // Round-off: the sums themselves over N ~ 10^3 terms carry N eps of their scale.
+  const double eps = std::numeric_limits<double>::epsilon() * double(n_before);
+  CHECK(std::abs(after.mass - before.mass) <= eps * before.mass);
+  CHECK((after.momentum - before.momentum).norm() <= eps * before.momentum_scale);
+  CHECK(ids_consistent(p));
+  // Daughters: a quarter (eighth) of the base mass at h = 1.3 of their own spacing.
+  for (std::size_t a = 0; a < p.size(); ++a) {
+    if (p.position[a][0] >= 0.4 - dp) continue;
+    CHECK(refinement.halvings(p.mass[a], rho0) == Dim);
+    CHECK(p.smoothing_length[a] == Approx(1.3 * std::pow(p.mass[a] / p.density[a], 1.0 / Dim)).epsilon(1e-12));
+  }
+}
+
+}  // namespace
+
+TEST_CASE("splitting and merging conserve mass and momentum to round-off on a random set", "[refinement]") {
+  check_conservation<2>(20);
+  check_conservation<3>(8);
+}
+
+// One coarse particle crosses the edge of a level-1 box: it splits into four (2D) daughters of a quarter of the mass
+// on the fine lattice of its cell. Moving the daughters back and forth across the edge by less than the buffer
+// width changes nothing (no flicker); once they are beyond the buffer two binary merges give the coarse particle
+// back with its mass exactly (quarters and halves of a binary float add exactly).
+TEST_CASE("a particle crossing a box edge splits, does not flicker within the buffer, merges back beyond it",
+          "[refinement]") {
+  RefSystem<2> system(Domain<2, double>(V2(0, 0), V2(1, 1)), Tait<double>(1000, 20));
+  auto& p = system.particles();
+  const double dp = 0.04, rho = 1000, m = rho * dp * dp;
+  p.add(Kind::fluid, V2(0.46, 0.5), V2(1, 0.5), rho, m, 1.3 * dp);
+  RefinementParameters<double> params;
+  params.base_spacing = dp;
+  params.buffer_width = 0.1;
+  ParticleRefinement<RefSystem<2>> refinement(system.domain(), {{V2(0.5, 0.1), V2(0.9, 0.9), 1}}, params);
+  system.update_neighbors();
+  auto shift = [&](double dx) {
+    for (auto& x : p.position) x[0] += dx;
+  };
+  refinement.advance(system, 0, 1e-3);
+  CHECK(p.size() == 1);  // outside the box
+  shift(0.06);           // x = 0.52: inside
+  refinement.advance(system, 0, 1e-3);
+  REQUIRE(p.size() == 4);
+  V2 centre = V2::Zero();
+  for (std::size_t a = 0; a < 4; ++a) {
+    CHECK(p.mass[a] == m / 4);
+    CHECK(p.smoothing_length[a] == Approx(1.3 * dp / 2).epsilon(1e-12));
+    CHECK(p.velocity[a] == V2(1, 0.5));
+    CHECK(std::abs(std::abs(p.position[a][0] - 0.52) - dp / 4) < 1e-12);  // the fine lattice of the cell
+    CHECK(std::abs(std::abs(p.position[a][1] - 0.5) - dp / 4) < 1e-12);
+    centre += 0.25 * p.position[a];
+  }
+  CHECK((centre - V2(0.52, 0.5)).norm() < 1e-12);
+  for (int k = 0; k < 5; ++k) {  // out by 0.09 (within the 0.1 buffer) and back in
+    shift(-0.09);
+    refinement.advance(system, 0, 1e-3);
+    CHECK(p.size() == 4);
+    shift(0.09);
+    refinement.advance(system, 0, 1e-3);
+    CHECK(p.size() == 4);
+  }
+  CHECK(refinement.total_counts().splits == 1);
+  CHECK(refinement.total_counts().merges == 0);
+  shift(-0.2);  // x = 0.32: more than the buffer from the box
+  refinement.advance(system, 0, 1e-3);
+  CHECK(p.size() == 2);
+  CHECK(refinement.last_counts().merges == 2);
+  refinement.advance(system, 0, 1e-3);
+  REQUIRE(p.size() == 1);
+  CHECK(p.mass[0] == m);
+  CHECK(p.smoothing_length[0] == Approx(1.3 * dp).epsilon(1e-12));
+  CHECK((p.position[0] - V2(0.32, 0.5)).norm() < 1e-12);
+  CHECK(p.velocity[0] == V2(1, 0.5));
+  refinement.advance(system, 0, 1e-3);
+  CHECK(p.size() == 1);  // nothing left to do
+}
+
+TEST_CASE("refinement: bad input gives an InputError naming the parameter and its valid range", "[refinement]") {
+  const Domain<2, double> domain(V2(0, 0), V2(1, 1));
+  RefinementParameters<double> ok;
+  ok.base_spacing = 0.01;
+  using Box = RefinementBox<2, double>;
+  using R = ParticleRefinement<RefSystem<2>>;
+  auto make = [&](std::vector<Box> boxes, RefinementParameters<double> params = {}) {
+    if (params.base_spacing == 0) params.base_spacing = 0.01;
+    return [=] { R(domain, boxes, params); };
+  };
+  const Box inside{V2(0.2, 0.2), V2(0.6, 0.6), 1};
+  CHECK_THROWS_WITH(make({{V2(0.2, 0.2), V2(1.2, 0.6), 1}})(),
+                    Catch::Contains("outside the domain") && Catch::Contains("valid range is [0, 1]"));
+  CHECK_THROWS_WITH(make({inside, {V2(0.5, 0.5), V2(0.8, 0.8), 2}})(),
+                    Catch::Contains("conflicting levels") && Catch::Contains("nested"));
+  CHECK_THROWS_WITH(make({{V2(0.2, 0.2), V2(0.6, 0.6), 0}})(), Catch::Contains("level = 0 is invalid"));
+  CHECK_THROWS_WITH(make({{V2(0.6, 0.2), V2(0.2, 0.6), 1}})(), Catch::Contains("must be greater than"));
+  RefinementParameters<double> bad = ok;
+  bad.ratio = 3;
+  CHECK_THROWS_WITH(make({inside}, bad)(), Catch::Contains("ratio = 3 is invalid: only 2 is supported"));
+  bad = ok;
+  bad.buffer_width = -0.01;
+  CHECK_THROWS_WITH(make({inside}, bad)(), Catch::Contains("buffer_width (m) = -0.01 is invalid"));
+  bad = ok;
+  bad.split_offset = 0.5;
+  CHECK_THROWS_WITH(make({inside}, bad)(), Catch::Contains("split_offset (eps) = 0.5 is invalid"));
+  bad = ok;
+  bad.base_spacing = -1;
+  CHECK_THROWS_WITH(make({inside}, bad)(), Catch::Contains("base_spacing (m) = -1 is invalid"));
+  // Allowed: nested boxes (finer inside coarser), overlapping boxes of one level, touching boxes.
+  CHECK_NOTHROW(make({inside, {V2(0.3, 0.3), V2(0.5, 0.5), 2}})());
+  CHECK_NOTHROW(make({inside, {V2(0.5, 0.5), V2(0.8, 0.8), 1}})());
+  CHECK_NOTHROW(make({inside, {V2(0.6, 0.2), V2(0.8, 0.6), 2}})());
+}
