@@ -28,10 +28,13 @@ int main(int argc, char** argv) try {
   cfg.level1_rows = static_cast<int>(cli.get_number("level1-rows", cfg.level1_rows, "base rows of the level-1 box"));
   cfg.level2_rows = static_cast<int>(cli.get_number("level2-rows", cfg.level2_rows, "base rows of the level-2 box"));
   cfg.buffer_rows = cli.get_number("buffer", cfg.buffer_rows, "merge buffer width, base spacings");
+  cfg.tank.smoothing_ratio = cli.get_number("smoothing-ratio", cfg.tank.smoothing_ratio, "h / spacing");
+  cfg.wall_columns =
+      static_cast<int>(cli.get_number("wall-columns", cfg.wall_columns, "coarse base columns next to each side wall"));
   const double end_time = cli.get_number("end-time", 1.0, "simulated time, s (settling)");
   const std::string refine = cli.get("refine", "on", "refinement boxes: on | off (the uniform tank)");
   const std::string correction =
-      cli.get("gradient-correction", "none", "kernel-gradient corrected pressure gradient: none | everywhere");
+      cli.get("gradient-correction", "none", "kernel-gradient corrected pressure gradient: none | everywhere | jumps");
   const double alpha = cli.get_number("alpha", 0.01, "artificial viscosity alpha");
   const std::filesystem::path output = cli.get("output", "refined_tank_output", "output folder");
   if (!cli.finish()) return 0;
@@ -44,6 +47,7 @@ int main(int argc, char** argv) try {
   auto fluid = tank::fluid_parameters(cfg.tank);
   fluid.artificial_viscosity = alpha;
   if (correction == "everywhere") fluid.gradient_correction = GradientCorrection::everywhere;
+  if (correction == "jumps") fluid.gradient_correction = GradientCorrection::resolution_jumps;
   RefinedSimulation sim(system, fluid, {}, Refinement(system.domain(), boxes, refinement_parameters(cfg)));
   const auto& refinement = sim.model<0>();
   const double mass0 = fluid_mass(system);

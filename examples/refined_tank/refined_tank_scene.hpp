@@ -27,6 +27,9 @@ struct RefinedTankConfig {
   int level1_rows{6};   ///< base rows covered by the level-1 box (centred on mid-depth, even)
   int level2_rows{2};   ///< base rows covered by the level-2 box inside it (even, < level1_rows)
   Real buffer_rows{1};  ///< merge buffer around the boxes, in base spacings
+  /// Base columns kept coarse next to each side wall by the level-1 box (the level-2 box keeps one more): the walls
+  /// are built at the base spacing, and fine particles against a coarse dynamic wall are sucked onto it.
+  int wall_columns{2};
   Real band_centre() const { return Real(0.5) * tank.depth; }  ///< m
 };
 
@@ -35,8 +38,9 @@ struct RefinedTankConfig {
 inline std::vector<RefinementBox<2, Real>> refinement_boxes(const RefinedTankConfig& cfg) {
   const Real dp = cfg.tank.dp(), zc = cfg.band_centre();
   const Real half1 = Real(0.5) * cfg.level1_rows * dp, half2 = Real(0.5) * cfg.level2_rows * dp;
-  return {{Vector(0, zc - half1), Vector(cfg.tank.width, zc + half1), 1},
-          {Vector(0, zc - half2), Vector(cfg.tank.width, zc + half2), 2}};
+  const Real x1 = cfg.wall_columns * dp, x2 = x1 + dp, w = cfg.tank.width;
+  return {{Vector(x1, zc - half1), Vector(w - x1, zc + half1), 1},
+          {Vector(x2, zc - half2), Vector(w - x2, zc + half2), 2}};
 }
 
 inline RefinementParameters<Real> refinement_parameters(const RefinedTankConfig& cfg) {
