@@ -322,3 +322,51 @@ TEST_CASE("hydrostatic tank with a refined band (dp, dp/2, dp/4) settles to hydr
   }
   CHECK(energy <= 2 * uniform_energy);
 }
+
+// A checkpoint written after merges (retired ids, ids beyond the particle count) restores the id map and its
+// capacity, and the resumed run is bit-identical to the uninterrupted one (the refinement keeps no state of its own).
+TEST_CASE("checkpoint after merging: ids, id capacity and the resumed run are exact", "[refinement][io]") {
+  using System2 = RefSystem<2>;
+  using Sim = Simulation<System2, SymplecticVerlet, ParticleRefinement<System2>>;
+  const double dp = 0.02;
+  auto build = [&](System2& s) {
+    add_fluid_block(s, V2(0, 0), V2(0.2, 0.1), Resolution<double>{dp}, 0.1);
+    // fine particles (a quarter of the mass) to the right, outside every box: they merge
+    for (int i = 0; i < 10; ++i)
+      for (int j = 0; j < 10; ++j)
+        s.particles().add(Kind::fluid, V2(0.2 + 0.5 * dp * (i + 0.5), 0.5 * dp * (j + 0.5)), V2::Zero(), 1000,
+                          1000 * 0.25 * dp * dp, 1.3 * 0.5 * dp);
+    add_box_walls(s, V2(0, 0), V2(0.3, 0.2), Resolution<double>{dp}, WallModel::dynamic);
+  };
+  RefinementParameters<double> params;
+  params.base_spacing = dp;
+  params.buffer_width = dp;
+  const Domain<2, double> domain(V2(-0.1, -0.1), V2(0.4, 0.3));
+  const std::vector<RefinementBox<2, double>> boxes{{V2(0.0, 0.0), V2(0.1, 0.05), 1}};
+  System2 a(domain, Tait<double>(1000, 10));
+  build(a);
+  Sim sim_a(a, FluidParameters<2, double>{}, {}, ParticleRefinement<System2>(domain, boxes, params));
+  for (int k = 0; k < 4; ++k) sim_a.step();
+  REQUIRE(sim_a.model<0>().total_counts().merges > 0);
+  REQUIRE(a.particles().id_capacity() > a.particles().size());
+  const auto path = std::filesystem::path(SPHFSI_TEST_OUTPUT_DIR) / "refinement" / "merged.chk";
+  std::filesystem::create_directories(path.parent_path());
+  io::write_checkpoint(path, sim_a);
+  System2 b(domain, Tait<double>(1000, 10));
+  Sim sim_b(b, FluidParameters<2, double>{}, {}, ParticleRefinement<System2>(domain, boxes, params));
+  io::read_checkpoint(path, sim_b);
+  CHECK(b.particles().id_capacity() == a.particles().id_capacity());
+  CHECK(b.particles().id == a.particles().id);
+  CHECK(ids_consistent(b.particles()));
+  for (int k = 0; k < 4; ++k) {
+    sim_a.step();
+    sim_b.step();
+  }
+  REQUIRE(b.size() == a.size());
+  bool identical = true;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    identical = identical && a.particles().position[i] == b.particles().position[i] &&
+                a.particles().mass[i] == b.particles().mass[i] && a.particles().id[i] == b.particles().id[i];
+  CHECK(identical);
+  CHECK(sim_b.time() == sim_a.time());
+}
