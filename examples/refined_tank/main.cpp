@@ -24,7 +24,7 @@ int main(int argc, char** argv) try {
                       "mid-depth; checks p = rho0 g (H_s - z) within 2 % in the band and the mass.");
   RefinedTankConfig cfg;
   cfg.tank.particles_over_depth = static_cast<int>(cli.get_number("resolution", 20, "base particles over depth"));
-  cfg.tank.width = cli.get_number("width", 0.2, "tank width, m");
+  cfg.tank.width = cli.get_number("width", 0.3, "tank width, m");
   cfg.level1_rows = static_cast<int>(cli.get_number("level1-rows", cfg.level1_rows, "base rows of the level-1 box"));
   cfg.level2_rows = static_cast<int>(cli.get_number("level2-rows", cfg.level2_rows, "base rows of the level-2 box"));
   cfg.buffer_rows = cli.get_number("buffer", cfg.buffer_rows, "merge buffer width, base spacings");
@@ -33,14 +33,18 @@ int main(int argc, char** argv) try {
       static_cast<int>(cli.get_number("wall-columns", cfg.wall_columns, "coarse base columns next to each side wall"));
   const double end_time = cli.get_number("end-time", 1.0, "simulated time, s (settling)");
   const std::string refine = cli.get("refine", "on", "refinement boxes: on | off (the uniform tank)");
-  const std::string correction =
-      cli.get("gradient-correction", "none", "kernel-gradient corrected pressure gradient: none | everywhere | jumps");
-  const double alpha = cli.get_number("alpha", 0.01, "artificial viscosity alpha");
+  const std::string correction = cli.get("gradient-correction", "jumps",
+                                         "pressure gradient: jumps (corrected difference form at resolution jumps) | "
+                                         "none (symmetric) | everywhere (Bonet-Lok everywhere)");
+  const double alpha = cli.get_number("alpha", 0.1, "artificial viscosity alpha");
   const std::filesystem::path output = cli.get("output", "refined_tank_output", "output folder");
   if (!cli.finish()) return 0;
   if (refine != "on" && refine != "off")
     throw InputError(fmt::format("--refine = '{}' is invalid: valid values are on, off", refine));
   require_positive("--end-time (s)", end_time);
+  if (correction != "jumps" && correction != "none" && correction != "everywhere")
+    throw InputError(
+        fmt::format("--gradient-correction = '{}' is invalid: valid values are jumps, none, everywhere", correction));
 
   System system = tank::make_tank(cfg.tank);
   auto boxes = refine == "on" ? refinement_boxes(cfg) : std::vector<RefinementBox<2, double>>{};

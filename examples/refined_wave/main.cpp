@@ -81,6 +81,8 @@ int main(int argc, char** argv) try {
   const double bed_rows = cli.get_number("bed-rows", 2, "base rows kept coarse above the bed");
   const double top_rows = cli.get_number(
       "top-rows", 0, "base rows kept coarse below the still surface (0: the box reaches above the crests)");
+  const std::string wall_viscosity =
+      cli.get("wall-viscosity", "off", "artificial viscosity with wall particles: on | off");
   const double end_override = cli.get_number("end-time", 0, "end time, s (0: from the waves to analyse)");
   if (!cli.finish()) return 0;
   if (refine != "on" && refine != "off")
@@ -90,7 +92,7 @@ int main(int argc, char** argv) try {
   const auto layout = scenes::build_wave_flume(system, g);
   FluidParameters<2, T> fluid = scenes::wave_flume_fluid(g);
   fluid.artificial_viscosity = alpha;
-  fluid.wall_artificial_viscosity = false;                           // the flume's default (docs/flume.md)
+  fluid.wall_artificial_viscosity = wall_viscosity == "on";          // off: the flume's default (docs/flume.md)
   fluid.gradient_correction = GradientCorrection::resolution_jumps;  // inert without resolution jumps
   const double L = g.wavelength(), dp = g.dp();
   // The box's ends lie on base-lattice cell edges, so the daughters tile their parents' cells.
