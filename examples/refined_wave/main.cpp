@@ -83,6 +83,8 @@ int main(int argc, char** argv) try {
       "top-rows", 0, "base rows kept coarse below the still surface (0: the box reaches above the crests)");
   const std::string wall_viscosity =
       cli.get("wall-viscosity", "off", "artificial viscosity with wall particles: on | off");
+  const std::string fine_bed =
+      cli.get("fine-bed", "off", "bed under the box built at the fine spacing: on | off (then use --bed-rows 0)");
   const double end_override = cli.get_number("end-time", 0, "end time, s (0: from the waves to analyse)");
   if (!cli.finish()) return 0;
   if (refine != "on" && refine != "off")
@@ -91,12 +93,25 @@ int main(int argc, char** argv) try {
   System system(scenes::wave_flume_domain(g), Tait<T>(1000, g.sound_speed()));
   const auto layout = scenes::build_wave_flume(system, g);
   FluidParameters<2, T> fluid = scenes::wave_flume_fluid(g);
-  fluid.artificial_viscosity = alpha;
-  fluid.wall_artificial_viscosity = wall_viscosity == "on";          // off: the flume's default (docs/flume.md)
-  fluid.gradient_correction = GradientCorrection::resolution_jumps;  // inert without resolution jumps
   const double L = g.wavelength(), dp = g.dp();
   // The box's ends lie on base-lattice cell edges, so the daughters tile their parents' cells.
   const double x0 = std::round(box_from * L / dp) * dp, x1 = std::round((box_from + box_length) * L / dp) * dp;
+  if (fine_bed == "on" && refine == "on") {
+    // The bed under the box at the fine spacing (same thickness): no fine fluid particle sees a coarse wall.
+    auto& p = system.particles();
+    for (std::size_t i = p.size(); i-- > 0;)
+      if (p.kind[i] == Kind::wall && p.body[i] == layout.wall_body && p.position[i][1] < 0 && p.position[i][0] > x0 &&
+          p.position[i][0] < x1)
+        p.remove(i);
+    const double fine = 0.5 * dp;
+    for_each_lattice_point<2, T>(V2(x0, -g.wall_layers * dp), V2(x1, 0), fine, [&](const V2& x) {
+      p.add(Kind::wall, x, V2::Zero(), 1000, 1000 * fine * fine, g.smoothing_ratio * fine, layout.wall_body);
+    });
+    set_hydrostatic_wall_density(system, g.depth(), g.wave.gravity);
+  }
+  fluid.artificial_viscosity = alpha;
+  fluid.wall_artificial_viscosity = wall_viscosity == "on";          // off: the flume's default (docs/flume.md)
+  fluid.gradient_correction = GradientCorrection::resolution_jumps;  // inert without resolution jumps
   std::vector<RefinementBox<2, T>> boxes;
   // From two base rows above the bed to above the crests: the bed is built at the base spacing, and fine particles
   // against a coarse dynamic wall are sucked onto it (measured: a blow-up within 0.1 s with the box down to the bed).

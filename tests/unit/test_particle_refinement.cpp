@@ -224,7 +224,7 @@ TEST_CASE("refinement: bad input gives an InputError naming the parameter and it
   ok.base_spacing = 0.01;
   using Box = RefinementBox<2, double>;
   using R = ParticleRefinement<RefSystem<2>>;
-  auto make = [&](std::vector<Box> boxes, RefinementParameters<double> params = {}) {
+  auto make = [&](const std::vector<Box>& boxes, RefinementParameters<double> params = {}) {
     if (params.base_spacing == 0) params.base_spacing = 0.01;
     return [=] { R(domain, boxes, params); };
   };
