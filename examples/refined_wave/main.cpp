@@ -66,6 +66,7 @@ int main(int argc, char** argv) try {
   g.wave.order = 2;
   g.particles_per_depth = cli.get_number("resolution", 8, "base particles over the depth, h/dp");
   g.length_wavelengths = cli.get_number("length", 4.5, "flume length, wavelengths");
+  g.sound_speed_factor = cli.get_number("sound-speed", 7, "c0 / sqrt(g h)");
   g.damping_wavelengths = 1.5;
   const double box_from = cli.get_number("box-from", 1.25, "refinement box start, wavelengths from the paddle");
   const double box_length = cli.get_number("box-length", 0.5, "refinement box length, wavelengths");
