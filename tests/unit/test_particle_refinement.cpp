@@ -346,8 +346,8 @@ TEST_CASE("checkpoint after merging: ids, id capacity and the resumed run are ex
   System2 a(domain, Tait<double>(1000, 10));
   build(a);
   Sim sim_a(a, FluidParameters<2, double>{}, {}, ParticleRefinement<System2>(domain, boxes, params));
-  for (int k = 0; k < 4; ++k) sim_a.step();
-  REQUIRE(sim_a.model<0>().total_counts().merges > 0);
+  sim_a.step();  // the fine particles merge at the end of the first step: the count changed after the evaluation
+  REQUIRE(sim_a.model<0>().last_counts().merges > 0);
   REQUIRE(a.particles().id_capacity() > a.particles().size());
   const auto path = std::filesystem::path(SPHFSI_TEST_OUTPUT_DIR) / "refinement" / "merged.chk";
   std::filesystem::create_directories(path.parent_path());
