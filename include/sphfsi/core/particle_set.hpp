@@ -58,8 +58,9 @@ struct ParticleSet {
   static constexpr std::uint32_t no_slot = std::numeric_limits<std::uint32_t>::max();
 
   /// Appends one particle with the next unused id and returns its slot (== its id until the first re-sort or
-  /// removal).
-  std::size_t add(Kind k, const Vector& x, const Vector& v, T rho, T m, T h, std::int32_t body_index = -1) {
+  /// removal). x and v may be elements of this set.
+  std::size_t add(Kind k, const Vector& x_in, const Vector& v_in, T rho, T m, T h, std::int32_t body_index = -1) {
+    const Vector x = x_in, v = v_in;  // copies: x_in, v_in may be elements of this set, and the arrays reallocate
     require_positive("particle density rho (kg/m^3)", rho);
     require_positive("particle mass m (kg)", m);
     require_positive("particle smoothing length h (m)", h);

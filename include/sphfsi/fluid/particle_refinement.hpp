@@ -298,9 +298,10 @@ class ParticleRefinement {
     for (std::size_t k = 0; k < count; ++k)
       if (!system.domain().contains(daughter_position(k))) return 0;
     const T h = params_.smoothing_ratio * daughter_spacing;
+    const Vector velocity = p.velocity[a];  // a copy: add() reallocates the arrays
     for (std::size_t k = 1; k < count; ++k) {
       const Vector x = daughter_position(k);
-      const std::size_t d = p.add(Kind::fluid, x, p.velocity[a], rho, m, h, p.body[a]);
+      const std::size_t d = p.add(Kind::fluid, x, velocity, rho, m, h, p.body[a]);
       p.pressure[d] = p.pressure[a];
       p.sound_speed[d] = p.sound_speed[a];
       p.acceleration[d] = p.acceleration[a];
