@@ -21,6 +21,7 @@
 #include <sphfsi/eos/concepts.hpp>
 #include <sphfsi/eos/linear.hpp>
 #include <sphfsi/eos/tait.hpp>
+#include <sphfsi/fluid/particle_refinement.hpp>
 #include <sphfsi/fluid/wcsph.hpp>
 #include <sphfsi/integrators/concepts.hpp>
 #include <sphfsi/integrators/predictor_corrector.hpp>

@@ -59,6 +59,12 @@ enum class GradientCorrection {
   none,                  ///< Monaghan's symmetric form everywhere (momentum conserved pair by pair)
   near_repulsive_walls,  ///< fluid particles with a repulsive wall particle within their support (cut kernels)
   everywhere,            ///< every fluid particle
+  /// Fluid particles with a neighbour of another smoothing length (a resolution jump, fluid/particle_refinement.hpp)
+  /// get the corrected gradient in difference form, -(1/rho_a) sum_b V_b (p_b - p_a) L_a grad_a W_ab: it vanishes
+  /// for a uniform pressure on any particle set, where the symmetric form's 2 p_a / rho_a sum_b V_b grad_a W_ab
+  /// (not zero across a jump of h) pushes with about 2 p / rho times 0.2 / h (measured: the refined still tank
+  /// mixes within 0.1 s). Momentum is then not exchanged pair-wise at those particles.
+  resolution_jumps,
 };
 
 template <int Dim, Real T>
@@ -190,6 +196,11 @@ class WcsphFluid {
   // gradient is blind to it.
   static constexpr T max_free_surface_moment = T(0.05);
 
+  // Smallest kernel sum sum_b V_b W_ab (self included) of a particle corrected at a resolution jump: 1 inside the
+  // fluid to the kernel's lattice error (1 % uniform, 7.6 % at a 2:1 jump, docs/variable-resolution.md), about
+  // 0.5 at a free surface.
+  static constexpr T min_interior_colour = T(0.85);
+
   // L_a for the fluid particles selected by gradient_correction (corrected_[a] = 1), from the moment matrix
   //   M_a = sum_b V_b (x_b - x_a) (x) grad_a W_ab = -sum_b V_b (dW/dr / r) dx dx^T   (dx = x_a - x_b)
   // over the neighbours that enter a's pressure sum (fluid, and dynamic wall particles). On a full lattice support
@@ -205,6 +216,17 @@ class WcsphFluid {
     corrected_.assign(n, 0);
     if (everywhere) {
       for (std::size_t a = 0; a < n; ++a) corrected_[a] = p.kind[a] == Kind::fluid;
+    } else if (params_.gradient_correction == GradientCorrection::resolution_jumps) {
+      if (system.uniform_smoothing_length()) return;
+      parallel_for(n, [&](std::size_t a) {
+        if (p.kind[a] != Kind::fluid) return;
+        const T ha = p.smoothing_length[a];
+        bool jump = false;
+        system.for_each_neighbor(a, [&](std::size_t b, const Vector&, T, T) {
+          jump = jump || (p.kind[b] != Kind::solid && std::abs(p.smoothing_length[b] - ha) > T(1e-3) * ha);
+        });
+        corrected_[a] = jump;
+      });
     } else if (!dynamic_walls) {
       for (std::size_t w = 0; w < n; ++w) {
         if (p.kind[w] != Kind::wall) continue;
@@ -220,6 +242,7 @@ class WcsphFluid {
       Mat<Dim, T> moment = Mat<Dim, T>::Zero();
       Vector gamma = Vector::Zero();        // sum_b V_b grad_a W_ab, 1/m
       Vector wall_normal = Vector::Zero();  // sum of the normals of the repulsive wall particles within the support
+      T colour = volume_[a] * kernel.value(T(0), p.smoothing_length[a]);  // sum_b V_b W_ab, self included
       system.for_each_neighbor(a, [&](std::size_t b, const Vector& dx, T r, T h) {
         const Kind kb = p.kind[b];
         if (kb == Kind::solid) return;
@@ -230,13 +253,21 @@ class WcsphFluid {
         const T grad_factor = r > T(0) ? kernel.derivative(r, h) / r : T(0);
         moment.noalias() -= (volume_[b] * grad_factor) * (dx * dx.transpose());
         gamma += (volume_[b] * grad_factor) * dx;
+        colour += volume_[b] * kernel.value(r, h);
       });
       if (!(moment.determinant() >= min_moment_determinant)) return;
+      // Resolution jumps: particles within about h of a free surface (colour below min_interior_colour) keep the
+      // symmetric form, whose missing support holds them to the surface; their pressure, and so the symmetric
+      // form's error at the jump, is small there.
+      if (params_.gradient_correction == GradientCorrection::resolution_jumps && colour < min_interior_colour) return;
       // Free-surface test: the part of gamma not along the wall normal comes from a support cut by something else
       // than the wall, a free surface; there the correction would remove the surface's restoring force.
       const T wall_norm = wall_normal.norm();
       if (wall_norm > T(0)) gamma -= gamma.dot(wall_normal) / (wall_norm * wall_norm) * wall_normal;
-      if (gamma.norm() * p.smoothing_length[a] > max_free_surface_moment) return;
+      // (At a resolution jump gamma is not zero inside the fluid either: there the test would reject every particle.)
+      if (params_.gradient_correction != GradientCorrection::resolution_jumps &&
+          gamma.norm() * p.smoothing_length[a] > max_free_surface_moment)
+        return;
       correction_[a] = moment.inverse();
       corrected_[a] = 1;
     });
@@ -317,6 +348,8 @@ class WcsphFluid {
     const T nu = params_.kinematic_viscosity;
     const bool dynamic_walls = params_.walls == WallModel::dynamic;
     const bool corrected = params_.gradient_correction != GradientCorrection::none;
+    const bool difference_form = params_.gradient_correction == GradientCorrection::resolution_jumps;
+    const T* pressure = p.pressure.data();
     const int up = params_.repulsive.vertical_axis;
     const T water_level = params_.repulsive.water_level;
     const Kind* kind = p.kind.data();
@@ -365,16 +398,21 @@ class WcsphFluid {
       const T laminar =
           nu > T(0) ? nu * (rho_a + rho_b) / (rho_a * rho_b) * grad_factor * r2 * inverse_distance2 : T(0);
       if (fluid_a) {
-        if (corrected && corrected_[a])  // -m_b [(P_b - P_a) L_a + (2 P_a + Pi_ab) I] grad
+        if (difference_form && corrected_[a])  // -(V_b / rho_a) (p_b - p_a) L_a grad - m_b Pi_ab grad
+          acc -= (volume[b] * (pressure[b] - pressure[a]) / rho_a) * (correction_[a] * grad) + (mass[b] * pi_ab) * grad;
+        else if (corrected && corrected_[a])  // -m_b [(P_b - P_a) L_a + (2 P_a + Pi_ab) I] grad
           acc -= mass[b] * ((pb - pa) * (correction_[a] * grad) + (T(2) * pa + pi_ab) * grad);
         else acc -= (mass[b] * force) * grad;
         if (nu > T(0)) acc += (mass[b] * laminar) * vab;
         mu_max = std::max(mu_max, std::abs(mu));
       }
       if (fluid_b) {
-        Vector acc_b = corrected && corrected_[b]  // grad_b W = -grad
-                           ? Vector(ma * ((pa - pb) * (correction_[b] * grad) + (T(2) * pb + pi_ab) * grad))
-                           : Vector((ma * force) * grad);
+        Vector acc_b =
+            difference_form && corrected_[b]
+                ? Vector((vol_a * (pressure[a] - pressure[b]) / rho_b) * (correction_[b] * grad) + (ma * pi_ab) * grad)
+            : corrected && corrected_[b]  // grad_b W = -grad
+                ? Vector(ma * ((pa - pb) * (correction_[b] * grad) + (T(2) * pb + pi_ab) * grad))
+                : Vector((ma * force) * grad);
         if (nu > T(0)) acc_b -= (ma * laminar) * vab;
         partner.add_acceleration(b, acc_b);
         partner.raise_signal_speed(b, std::abs(mu));

@@ -147,7 +147,8 @@ class Simulation {
     run(end_time, [](Simulation&) {});
   }
 
-  /// Initial positions of moving wall particles, indexed by particle id (empty without set_wall_motion).
+  /// Initial positions of moving wall particles, indexed by particle id, one entry per id given out when the
+  /// motion was set (empty without set_wall_motion).
   const std::vector<Vector>& wall_reference_positions() const noexcept { return reference_position_; }
 
   /// Whether the initial rate evaluation has been done (the first step() or run() does it).
@@ -160,11 +161,18 @@ class Simulation {
                      bool rates_evaluated = true) {
     require_finite("Simulation::restore_state time (s)", time);
     require_non_negative("Simulation::restore_state last_dt (s)", last_dt);
-    if ((!motions_.empty() || !kinematics_.empty()) && wall_reference_positions.size() != system_.particles().size())
-      throw InputError(
-          fmt::format("Simulation::restore_state wall_reference_positions has {} entries: with moving "
-                      "walls it needs one per particle ({})",
-                      wall_reference_positions.size(), system_.particles().size()));
+    if (!motions_.empty() || !kinematics_.empty()) {
+      // Indexed by id: it must cover every wall particle's id (fluid ids may have grown since, by splitting).
+      const auto& p = system_.particles();
+      std::size_t needed = 0;
+      for (std::size_t i = 0; i < p.size(); ++i)
+        if (p.kind[i] == Kind::wall) needed = std::max<std::size_t>(needed, std::size_t(p.id[i]) + 1);
+      if (wall_reference_positions.size() < std::max<std::size_t>(needed, 1))
+        throw InputError(
+            fmt::format("Simulation::restore_state wall_reference_positions has {} entries: with moving "
+                        "walls it needs one per particle id up to every wall particle's id ({})",
+                        wall_reference_positions.size(), std::max<std::size_t>(needed, 1)));
+    }
     time_ = time;
     steps_ = steps;
     dt_ = last_dt;
@@ -249,7 +257,7 @@ class Simulation {
  private:
   void record_reference_positions() {
     const auto& p = system_.particles();
-    reference_position_.resize(p.size());
+    reference_position_.resize(p.id_capacity());  // indexed by id
     for (std::size_t i = 0; i < p.size(); ++i) reference_position_[p.id[i]] = p.position[i];
   }
 

@@ -369,8 +369,10 @@ void write_checkpoint(const std::filesystem::path& path, const Sim& sim) {
   w.write("particles.position_old", p.position_old);
   w.write("particles.velocity_old", p.velocity_old);
   w.write("particles.density_old", p.density_old);
-  std::vector<std::uint32_t> slot_of_id(p.size());
-  for (std::size_t k = 0; k < p.size(); ++k)
+  // One entry per id below id_capacity() (== the particle count unless particles were removed, e.g. merged:
+  // removed ids hold ParticleSet::no_slot), so the reader restores the id capacity too.
+  std::vector<std::uint32_t> slot_of_id(p.id_capacity());
+  for (std::size_t k = 0; k < slot_of_id.size(); ++k)
     slot_of_id[k] = static_cast<std::uint32_t>(p.slot_of_id(static_cast<std::uint32_t>(k)));
   w.write("particles.slot_of_id", slot_of_id);
   w.write("fluid.signal_speed", sim.fluid().signal_speeds());
@@ -478,23 +480,29 @@ void read_checkpoint(const std::filesystem::path& path, Sim& sim) {
     if (static_cast<std::uint8_t>(p.kind[i]) > static_cast<std::uint8_t>(Kind::solid))
       r.fail(fmt::format("particle in slot {} has an unknown kind {}", i, static_cast<int>(p.kind[i])));
   std::vector<std::uint32_t> slot_of_id;
-  r.read_exact("particles.slot_of_id", slot_of_id, n);
+  r.read("particles.slot_of_id", slot_of_id);
+  if (slot_of_id.size() < n)
+    r.fail(fmt::format("field 'particles.slot_of_id' holds {} values, expected at least {}", slot_of_id.size(), n));
   try {
-    p.rebuild_slot_of_id();
+    p.rebuild_slot_of_id(slot_of_id.size());
   } catch (const InputError& e) {
     r.fail(e.what());
   }
-  for (std::size_t k = 0; k < n; ++k)
+  for (std::size_t k = 0; k < slot_of_id.size(); ++k)
     if (p.slot_of_id(static_cast<std::uint32_t>(k)) != slot_of_id[k])
       r.fail(fmt::format("id -> slot map disagrees with the ids at id {}", k));
   std::vector<T> signal_speed;
   r.read("fluid.signal_speed", signal_speed);
-  if (!signal_speed.empty() && signal_speed.size() != n)
-    r.fail(fmt::format("field 'fluid.signal_speed' holds {} values, expected 0 or {}", signal_speed.size(), n));
+  // One per slot of the last evaluation: a particle refinement pass after it (fluid/particle_refinement.hpp) may
+  // have changed the count since, so any count up to the id capacity is accepted (the fluid reads it guarded).
+  if (signal_speed.size() > slot_of_id.size())
+    r.fail(fmt::format("field 'fluid.signal_speed' holds {} values, expected at most {}", signal_speed.size(),
+                       slot_of_id.size()));
   std::vector<Vector> wall_reference;
   r.read("walls.reference_position", wall_reference);
-  if (!wall_reference.empty() && wall_reference.size() != n)
-    r.fail(fmt::format("field 'walls.reference_position' holds {} values, expected 0 or {}", wall_reference.size(), n));
+  if (wall_reference.size() > slot_of_id.size())
+    r.fail(fmt::format("field 'walls.reference_position' holds {} values, expected at most one per id ({})",
+                       wall_reference.size(), slot_of_id.size()));
   std::uint64_t models = 0;
   r.read("models.count", models);
   if (models != Sim::model_count)

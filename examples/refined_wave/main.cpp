@@ -1,0 +1,251 @@
+// sphfsi example: a regular wave crossing a refined zone (issue 9 part 3). The flume of examples/wave_flume (piston,
+// h = 0.16 m, T = 1.4286 s, target H = 0.028 m, kh = 0.593, L = 1.695 m, damping zone at the far end) at a coarse
+// base resolution, with one refinement box (level 1, dp/2) over half a wavelength from two base rows above the bed
+// to above the crests
+// (fluid/particle_refinement.hpp: particles split where they enter it, merge beyond a buffer downstream).
+// The flume has its own height deficit and decay (docs/flume.md), so the criteria compare the SAME flume run without
+// the box (`--refine off`, written first; pass its output folder with `--compare`):
+//   transmission: the zero up-crossing height downstream of the zone within 3 % of the uniform run's;
+//   reflection: the amplitude of eta_refined(t) - eta_uniform(t) at an upstream gauge (sqrt(2) x its RMS once a wave
+//               reflected at the zone has arrived) below 2 % of the incident amplitude H_uniform / 2 there.
+// Writes <output>/gauges.csv, <output>/counts.csv (fluid particles per level, mass change, splits, merges over time)
+// and, with --compare, <output>/comparison.csv. docs/variable-resolution.md section 3 gives the results.
+#include <sphfsi/analysis/zero_crossing.hpp>
+#include <sphfsi/eos/tait.hpp>
+#include <sphfsi/fluid/particle_refinement.hpp>
+#include <sphfsi/integrators/simulation.hpp>
+#include <sphfsi/integrators/symplectic.hpp>
+#include <sphfsi/io/command_line.hpp>
+#include <sphfsi/io/csv.hpp>
+#include <sphfsi/kernel/wendland_c2.hpp>
+#include <sphfsi/scenes/wave_flume.hpp>
+#include <sphfsi/waves/gauges.hpp>
+#include <sphfsi/waves/wavemaker.hpp>
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+
+using namespace sphfsi;
+using T = double;
+using V2 = Vec<2, T>;
+using System = ParticleSystem<2, T, WendlandC2<2>, Tait<T>>;
+using Refinement = ParticleRefinement<System>;
+using Solver = Simulation<System, SymplecticVerlet, waves::DampingZone<T>, Refinement>;
+
+namespace {
+
+double mean(const std::vector<double>& v) {
+  double s = 0;
+  for (double x : v) s += x;
+  return v.empty() ? 0 : s / double(v.size());
+}
+
+// Linear interpolation of (t, y) at time s (t increasing).
+double interpolate(const std::vector<double>& t, const std::vector<double>& y, double s) {
+  const auto it = std::lower_bound(t.begin(), t.end(), s);
+  if (it == t.begin()) return y.front();
+  if (it == t.end()) return y.back();
+  const std::size_t k = std::size_t(it - t.begin());
+  const double w = (s - t[k - 1]) / (t[k] - t[k - 1]);
+  return (1 - w) * y[k - 1] + w * y[k];
+}
+
+}  // namespace
+
+int main(int argc, char** argv) try {
+  io::CommandLine cli(argc, argv,
+                      "refined_wave: a regular wave crossing a refined zone (level 1 over half a wavelength, full "
+                      "depth); run --refine off first, then --refine on --compare <that output>.");
+  scenes::WaveFlumeGeometry<T> g;
+  g.wave.wave_height = 0.028;
+  g.wave.period = 1.4286;
+  g.wave.depth = 0.16;
+  g.wave.order = 2;
+  g.particles_per_depth = cli.get_number("resolution", 8, "base particles over the depth, h/dp");
+  g.length_wavelengths = cli.get_number("length", 4.5, "flume length, wavelengths");
+  g.sound_speed_factor = cli.get_number("sound-speed", 7, "c0 / sqrt(g h)");
+  g.damping_wavelengths = 1.5;
+  const double box_from = cli.get_number("box-from", 1.25, "refinement box start, wavelengths from the paddle");
+  const double box_length = cli.get_number("box-length", 0.5, "refinement box length, wavelengths");
+  const double buffer_dp = cli.get_number("buffer", 5, "merge buffer width, base spacings");
+  const double upstream = cli.get_number("upstream-gauge", 0.75, "upstream gauge, wavelengths from the paddle");
+  const double downstream = cli.get_number("downstream-gauge", 2.25, "downstream gauge, wavelengths");
+  const double alpha = cli.get_number("alpha", 0.01, "artificial viscosity alpha (both runs)");
+  const std::string refine = cli.get("refine", "on", "refinement box: on | off (the uniform flume)");
+  const std::string compare = cli.get("compare", "", "output folder of the --refine off run to compare with");
+  const double settle = cli.get_number("settle", 4, "periods after the linear arrival before a gauge is analysed");
+  const double waves_analysed = cli.get_number("waves", 3, "full waves analysed at the downstream gauge");
+  const std::filesystem::path out = cli.get("output", "out/refined_wave", "output folder");
+  const double bed_rows = cli.get_number("bed-rows", 2, "base rows kept coarse above the bed");
+  const double top_rows = cli.get_number(
+      "top-rows", 0, "base rows kept coarse below the still surface (0: the box reaches above the crests)");
+  const std::string wall_viscosity =
+      cli.get("wall-viscosity", "off", "artificial viscosity with wall particles: on | off");
+  const std::string fine_bed =
+      cli.get("fine-bed", "off", "bed under the box built at the fine spacing: on | off (then use --bed-rows 0)");
+  const double end_override = cli.get_number("end-time", 0, "end time, s (0: from the waves to analyse)");
+  if (!cli.finish()) return 0;
+  if (refine != "on" && refine != "off")
+    throw InputError(fmt::format("--refine = '{}' is invalid: valid values are on, off", refine));
+
+  System system(scenes::wave_flume_domain(g), Tait<T>(1000, g.sound_speed()));
+  const auto layout = scenes::build_wave_flume(system, g);
+  FluidParameters<2, T> fluid = scenes::wave_flume_fluid(g);
+  const double L = g.wavelength(), dp = g.dp();
+  // The box's ends lie on base-lattice cell edges, so the daughters tile their parents' cells.
+  const double x0 = std::round(box_from * L / dp) * dp, x1 = std::round((box_from + box_length) * L / dp) * dp;
+  if (fine_bed == "on" && refine == "on") {
+    // The bed under the box at the fine spacing (same thickness): no fine fluid particle sees a coarse wall.
+    auto& p = system.particles();
+    for (std::size_t i = p.size(); i-- > 0;)
+      if (p.kind[i] == Kind::wall && p.body[i] == layout.wall_body && p.position[i][1] < 0 && p.position[i][0] > x0 &&
+          p.position[i][0] < x1)
+        p.remove(i);
+    const double fine = 0.5 * dp;
+    for_each_lattice_point<2, T>(V2(x0, -g.wall_layers * dp), V2(x1, 0), fine, [&](const V2& x) {
+      p.add(Kind::wall, x, V2::Zero(), 1000, 1000 * fine * fine, g.smoothing_ratio * fine, layout.wall_body);
+    });
+    set_hydrostatic_wall_density(system, g.depth(), g.wave.gravity);
+  }
+  fluid.artificial_viscosity = alpha;
+  fluid.wall_artificial_viscosity = wall_viscosity == "on";          // off: the flume's default (docs/flume.md)
+  fluid.gradient_correction = GradientCorrection::resolution_jumps;  // inert without resolution jumps
+  std::vector<RefinementBox<2, T>> boxes;
+  // From two base rows above the bed to above the crests: the bed is built at the base spacing, and fine particles
+  // against a coarse dynamic wall are sucked onto it (measured: a blow-up within 0.1 s with the box down to the bed).
+  // top_rows > 0: the box ends top_rows base rows below the still surface (a submerged zone); 0: above the crests.
+  const double z1 = top_rows > 0 ? g.depth() - top_rows * dp : g.wall_height();
+  if (refine == "on") boxes.push_back({V2(x0, bed_rows * dp), V2(x1, z1), 1});
+  RefinementParameters<T> params;
+  params.base_spacing = dp;
+  params.buffer_width = buffer_dp * dp;
+  params.smoothing_ratio = g.smoothing_ratio;
+  waves::DampingZone<T> damping = g.damping_zone();
+  Solver sim(system, fluid, {}, damping, Refinement(system.domain(), boxes, params));
+  const waves::Wavemaker<T> maker(g.wave);
+  sim.set_wall_motion(layout.paddle_body, maker.piston_motion<2>());
+  const auto wave = maker.wave();
+  sim.set_expected_flow_speed(wave.surface_orbital_velocity(g.wave.wave_height));
+  const auto& refinement = sim.model<1>();
+
+  const std::vector<T> gauge_x{upstream * L, downstream * L};
+  const double c_g = wave.group_velocity, period = g.wave.period;
+  const double end_time =
+      end_override > 0 ? end_override : maker.ramp_time() + gauge_x[1] / c_g + (settle + waves_analysed + 0.5) * period;
+  fmt::print(
+      "refined wave ({}): dp = {:.4f} m (h/dp = {:.0f}, H/dp = {:.2f}), L = {:.3f} m, box [{:.3f}, {:.3f}] m "
+      "(level 1, buffer {:.3f} m), gauges at {:.3f} and {:.3f} m, {} fluid + {} wall particles, alpha = {}, end "
+      "{:.2f} s\n",
+      refine, dp, g.particles_per_depth, g.wave.wave_height / dp, L, x0, x1, params.buffer_width, gauge_x[0],
+      gauge_x[1], layout.fluid_particles, system.size() - layout.fluid_particles, alpha, end_time);
+
+  std::filesystem::create_directories(out);
+  waves::WaveGauges<T> gauges(gauge_x, layout.still_level, dp);
+  gauges.open(out / "gauges.csv", fmt::format("refined_wave ({}): eta (m) at x (m) = column suffix", refine));
+  io::CsvWriter counts_csv(out / "counts.csv", {"t", "fluid", "level0", "level1", "mass_change", "splits", "merges"},
+                           "fluid particles per level (intermediate masses with the coarser), relative mass change");
+  auto fluid_mass = [&] {
+    double m = 0;
+    const auto& p = system.particles();
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (p.kind[i] == Kind::fluid) m += p.mass[i];
+    return m;
+  };
+  const double mass0 = fluid_mass();
+  auto write_counts = [&](double t) {
+    const auto& p = system.particles();
+    std::size_t n = 0, level[2] = {0, 0};
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      if (p.kind[i] != Kind::fluid) continue;
+      ++n;
+      ++level[refinement.halvings(p.mass[i], 1000) >= 2 ? 1 : 0];
+    }
+    counts_csv.write_row({t, double(n), double(level[0]), double(level[1]), (fluid_mass() - mass0) / mass0,
+                          double(refinement.total_counts().splits), double(refinement.total_counts().merges)});
+  };
+  const double sample_every = period / 80;
+  double next_sample = 0, next_count = 0;
+  gauges.sample(system, 0);
+  write_counts(0);
+  const auto start = std::chrono::steady_clock::now();
+  sim.run(end_time, [&](Solver& s) {
+    if (s.time() >= next_sample) {
+      gauges.sample(s.system(), s.time());
+      next_sample += sample_every;
+    }
+    if (s.time() >= next_count) {
+      write_counts(s.time());
+      next_count += 0.25;
+    }
+  });
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  write_counts(sim.time());
+  fmt::print("{} steps, {:.1f} s wall; {} splits, {} merges; mass change {:.2e}; {} fluid particles at the end\n",
+             sim.step_count(), wall, refinement.total_counts().splits, refinement.total_counts().merges,
+             (fluid_mass() - mass0) / mass0, system.particles().count(Kind::fluid));
+
+  {
+    io::CsvWriter particles_csv(out / "particles.csv", {"x", "z", "level", "pressure", "speed"},
+                                fmt::format("fluid particles at t = {} s", sim.time()));
+    const auto& p = system.particles();
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (p.kind[i] == Kind::fluid)
+        particles_csv.write_row({p.position[i][0], p.position[i][1], refinement.halvings(p.mass[i], 1000) / 2.0,
+                                 p.pressure[i], p.velocity[i].norm()});
+  }
+  if (end_override > 0) return 0;
+  // Heights at both gauges once the full waves have arrived.
+  const std::vector<double> t(gauges.times().begin(), gauges.times().end());
+  auto height = [&](const std::vector<double>& tt, const std::vector<double>& eta, std::size_t i) {
+    const double from = maker.ramp_time() + gauge_x[i] / c_g + settle * period;
+    return analysis::zero_crossing_analysis(tt, eta, from, end_time).mean_height;
+  };
+  std::vector<double> eta[2];
+  for (std::size_t i = 0; i < 2; ++i) {
+    eta[i].assign(gauges.series(i).begin(), gauges.series(i).end());
+    fmt::print("gauge x = {:.3f} m: H = {:.5f} m ({:.3f} H_target)\n", gauge_x[i], height(t, eta[i], i),
+               height(t, eta[i], i) / g.wave.wave_height);
+  }
+  if (compare.empty()) return 0;
+
+  const auto table = io::read_csv(std::filesystem::path(compare) / "gauges.csv");
+  const std::vector<double> tu = table.column("t");
+  std::vector<double> eu[2];
+  for (std::size_t i = 0; i < 2; ++i) eu[i] = table.column(gauges.column_name(i));
+  const double h_down_u = height(tu, eu[1], 1), h_down_r = height(t, eta[1], 1);
+  const double transmission = h_down_r / h_down_u - 1;
+  // Reflection: from the time a wave reflected at the box's upstream end reaches the upstream gauge (linear
+  // group velocity, plus the settling periods) to the end; the refined record interpolated to the uniform's times.
+  const double h_up_u = height(tu, eu[0], 0);
+  const double reflected_from = maker.ramp_time() + (2 * x0 - gauge_x[0]) / c_g + settle * period;
+  std::vector<double> diff;
+  io::CsvWriter cmp(
+      out / "comparison.csv", {"t", "eta_up_uniform", "eta_up_refined", "difference"},
+      fmt::format("upstream gauge x = {} m; reflected waves arrive from t = {} s", gauge_x[0], reflected_from));
+  for (std::size_t k = 0; k < tu.size(); ++k) {
+    if (tu[k] > sim.time()) break;
+    const double er = interpolate(t, eta[0], tu[k]);
+    cmp.write_row({tu[k], eu[0][k], er, er - eu[0][k]});
+    if (tu[k] >= reflected_from) diff.push_back(er - eu[0][k]);
+  }
+  double rms = 0;
+  const double m = mean(diff);
+  for (double d : diff) rms += (d - m) * (d - m);
+  rms = diff.empty() ? 0 : std::sqrt(rms / double(diff.size()));
+  const double reflection = std::sqrt(2.0) * rms / (0.5 * h_up_u);
+  fmt::print("downstream H: refined {:.5f} m, uniform {:.5f} m: {:+.2f} % (criterion 3 %)\n", h_down_r, h_down_u,
+             100 * transmission);
+  fmt::print(
+      "upstream difference eta_r - eta_u from t = {:.2f} s ({} samples): amplitude sqrt(2) RMS = {:.2e} m, "
+      "{:.2f} % of the incident amplitude {:.5f} m (criterion 2 %)\n",
+      reflected_from, diff.size(), std::sqrt(2.0) * rms, 100 * reflection, 0.5 * h_up_u);
+  const bool pass = std::abs(transmission) <= 0.03 && reflection <= 0.02;
+  fmt::print("{}\n", pass ? "PASS" : "FAIL");
+  return pass ? 0 : 1;
+} catch (const std::exception& e) {
+  fmt::print(stderr, "refined_wave: {}\n", e.what());
+  return 2;
+}
