@@ -2,8 +2,10 @@
 //
 // Still-water depth h = 0.2 m, piston paddle at x = 0, one plant (or a meadow of N plants) clamped in the bed from
 // x = 1.2 m, gauges at x = 0.6, 1.0, 1.3 and 1.7 m, a damping zone beyond x = 2 m (scenes/posidonia_flume.hpp).
-// The plants are total-Lagrangian elastic blades coupled to the fluid by the paper's retained repulsive-force
-// coupling (eqs 17-23) with the depth factor eps(z) referred to the still-water level. The same flume is run
+// The plants are the real blades (--blade rod, the default: one elastic rod per plant, t = 0.1 mm, pushed on both
+// faces; scenes/meadow.hpp) or total-Lagrangian continuum blades 3 particles thick (--blade scaled|equivalent),
+// coupled to the fluid by the paper's retained repulsive-force coupling (eqs 17-23; for the continuum blades with
+// the depth factor eps(z) referred to the still-water level). The same flume is run
 // with and without plants at equal resolution (the empty flume loses 11-15 % of the height per wavelength at
 // these resolutions, docs/flume.md, so the plants' effect is the difference of the two runs).
 // Output (--output DIR): DIR/plants and DIR/empty with gauges.csv, wave_heights.csv, (plants) tips.csv and VTK
@@ -20,6 +22,7 @@
 #include <sphfsi/io/vtk_writer.hpp>
 #include <sphfsi/kernel/wendland_c2.hpp>
 #include <sphfsi/scenes/gate_tip_comparison.hpp>
+#include <sphfsi/scenes/meadow.hpp>
 #include <sphfsi/scenes/posidonia_flume.hpp>
 #include <sphfsi/solid/total_lagrangian.hpp>
 #include <sphfsi/waves/gauges.hpp>
@@ -56,7 +59,8 @@ struct Options {
 struct CaseResult {
   std::vector<double> height, height_std, period;  // per gauge (NaN where no complete wave)
   std::vector<double> tip_dx_amplitude, tip_dz_amplitude, tip_dx_mean, tip_dz_mean;  // per plant, m
-  std::size_t fluid{0}, wall{0}, solid{0}, steps{0}, solid_sub_steps{0}, fluid_inside_max{0};
+  std::size_t fluid{0}, wall{0}, solid{0}, steps{0}, solid_sub_steps{0}, fluid_inside_max{0}, crossings{0};
+  double lowest_node{std::numeric_limits<double>::quiet_NaN()};  // rods: lowest free node above the bed, m
   double wall_seconds{0}, end_time{0}, reached{0}, max_stretch{1};
   std::string failure;
 };
@@ -74,14 +78,21 @@ scenes::PosidoniaFlume<T> converted(const scenes::PosidoniaFlume<double>& s) {
   c.real_density = T(s.real_density), c.real_youngs_modulus = T(s.real_youngs_modulus);
   c.real_thickness = T(s.real_thickness), c.poisson_ratio = T(s.poisson_ratio);
   c.equivalent_bulk_modulus = T(s.equivalent_bulk_modulus);
+  c.rod_node_spacing = T(s.rod_node_spacing), c.rod_added_mass = T(s.rod_added_mass);
+  c.rod_load_smoothing = s.rod_load_smoothing, c.rod_velocity_factor = s.rod_velocity_factor;
+  c.rod_repulsion = T(s.rod_repulsion);
   return c;
 }
 
-template <class T, bool WithPlants>
+/// What stands in the flume: nothing, continuum blades (scaled, equivalent) or rods (the real blade).
+enum class Plants { none, continuum, rods };
+
+template <class T, Plants Kind>
 CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
+  constexpr bool WithPlants = Kind != Plants::none, Rods = Kind == Plants::rods;
   using System = ParticleSystem<2, T, WendlandC2<2>, Tait<T>>;
   using Solid = TotalLagrangianSolid<System>;
-  using Plant = CoupledBody<RepulsiveForce<T>, Solid>;
+  using Plant = std::conditional_t<Rods, scenes::RodBlades<System>, CoupledBody<RepulsiveForce<T>, Solid>>;
   using Solver = std::conditional_t<WithPlants, Simulation<System, SymplecticVerlet, waves::DampingZone<T>, Plant>,
                                     Simulation<System, SymplecticVerlet, waves::DampingZone<T>>>;
   scenes::PosidoniaFlume<T> scene = converted<T>(o.scene);
@@ -94,7 +105,9 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
   fluid.density_diffusion = T(o.delta);
 
   auto make_solver = [&]() {
-    if constexpr (WithPlants) {
+    if constexpr (Rods) {
+      return Solver(system, fluid, {}, g.damping_zone(), scenes::add_posidonia_rods(system, scene, layout));
+    } else if constexpr (WithPlants) {
       typename Solid::Parameters params;
       params.gravity = Vec<2, T>(0, -g.wave.gravity);
       params.stretch_limit = T(3);
@@ -135,8 +148,9 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
                           WithPlants ? fmt::format("{} plants", scene.plants) : "empty", double(scene.depth),
                           double(scene.period), double(scene.wave_height), double(scene.particles_per_depth)));
   // tips: mean displacement of each plant's top row from its rest position
+  const std::size_t plant_count = WithPlants ? layout.plant_x.size() : 0;
   std::vector<std::string> tip_columns{"t"};
-  for (std::size_t k = 0; k < layout.tips.size(); ++k) {
+  for (std::size_t k = 0; k < plant_count; ++k) {
     tip_columns.push_back(fmt::format("dx_{}", k));
     tip_columns.push_back(fmt::format("dz_{}", k));
   }
@@ -146,14 +160,16 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
                      fmt::format("plant tip (top row mean) displacement (m); plant centre lines x = {} m",
                                  fmt::join(layout.plant_x, ", ")));
   auto tip_position = [&](const System& s, std::size_t k) {
+    if constexpr (Rods) return Vec<2, T>(sim.template model<1>().rod(k).tip_position());
     Vec<2, T> c = Vec<2, T>::Zero();
     for (auto id : layout.tips[k]) c += s.particles().position[s.particles().slot_of_id(id)];
     return Vec<2, T>(c / T(layout.tips[k].size()));
   };
   std::vector<Vec<2, T>> tip0;
-  for (std::size_t k = 0; k < layout.tips.size(); ++k) tip0.push_back(tip_position(system, k));
+  for (std::size_t k = 0; k < plant_count; ++k) tip0.push_back(tip_position(system, k));
   std::vector<double> times;
-  std::vector<std::vector<double>> tip_dx(layout.tips.size()), tip_dz(layout.tips.size());
+  std::vector<std::vector<double>> tip_dx(plant_count), tip_dz(plant_count);
+  scenes::BladeCrossingCounter<System> crossings(T(1.5) * scene.dp());
 
   io::VtkSeriesWriter vtk(dir, "posidonia_flume");
   const double sample_every = double(scene.period) / 40;
@@ -168,7 +184,7 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
         if constexpr (WithPlants) {
           std::vector<double> row{double(sm.time())};
           times.push_back(double(sm.time()));
-          for (std::size_t k = 0; k < layout.tips.size(); ++k) {
+          for (std::size_t k = 0; k < plant_count; ++k) {
             const Vec<2, T> d = tip_position(sm.system(), k) - tip0[k];
             row.push_back(double(d[0]));
             row.push_back(double(d[1]));
@@ -176,9 +192,17 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
             tip_dz[k].push_back(double(d[1]));
           }
           tips_csv->write_row(row);
-          r.max_stretch = std::max(r.max_stretch, double(sm.template model<1>().solid().max_stretch()));
-          r.fluid_inside_max =
-              std::max(r.fluid_inside_max, scenes::fluid_particles_inside_solid(sm.system(), layout.plant_body));
+          if constexpr (Rods) {
+            const auto& rods = sm.template model<1>();
+            r.max_stretch = std::max(r.max_stretch, double(rods.max_stretch()));
+            crossings.update(sm.system(), rods);
+            const double low = double(rods.lowest_free_node(T(0), T(0)));
+            r.lowest_node = std::isnan(r.lowest_node) ? low : std::min(r.lowest_node, low);
+          } else {
+            r.max_stretch = std::max(r.max_stretch, double(sm.template model<1>().solid().max_stretch()));
+            r.fluid_inside_max =
+                std::max(r.fluid_inside_max, scenes::fluid_particles_inside_solid(sm.system(), layout.plant_body));
+          }
         }
         next_sample += sample_every;
       }
@@ -196,7 +220,8 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
   r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   r.steps = sim.step_count();
   r.reached = double(sim.time());
-  if constexpr (WithPlants) r.solid_sub_steps = sim.template model<1>().solid().sub_step_total();
+  if constexpr (Rods) r.solid_sub_steps = sim.template model<1>().sub_step_total(), r.crossings = crossings.total();
+  else if constexpr (WithPlants) r.solid_sub_steps = sim.template model<1>().solid().sub_step_total();
   fmt::print("{} steps to t = {:.2f} s, {:.1f} s wall ({:.2f} million particle-steps/s)\n", r.steps, r.reached,
              r.wall_seconds, double(system.size()) * double(r.steps) / r.wall_seconds * 1e-6);
 
@@ -218,7 +243,7 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
     heights.write_row({x, H, s, T_, n});
   }
   // tip excursion: half the peak-to-peak displacement once the full waves have reached the plant
-  for (std::size_t k = 0; k < layout.tips.size(); ++k) {
+  for (std::size_t k = 0; k < plant_count; ++k) {
     const double from =
         double(maker.ramp_time()) + double(layout.plant_x[k]) / double(wave.group_velocity) + double(wave.period);
     double lo_x = 1e9, hi_x = -1e9, lo_z = 1e9, hi_z = -1e9, sum_x = 0, sum_z = 0;
@@ -236,6 +261,10 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
     r.tip_dz_mean.push_back(n ? sum_z / double(n) : nan);
   }
   return r;
+}
+
+const char* blade_name(scenes::BladeModel b) {
+  return b == scenes::BladeModel::rod ? "rod" : b == scenes::BladeModel::scaled ? "scaled" : "equivalent";
 }
 
 template <class T>
@@ -261,17 +290,27 @@ int run(const Options& o) {
       "{:.4f} m ({} rows);\n  rho_m = {:.4g} kg/m^3, E_m = {:.4g} Pa, nu_m = {:.5g} (K_m = {:.4g} Pa), "
       "P-wave speed {:.3g} m/s; bending stiffness per width {:.3g} N m (real E t^3/12 = {:.3g} N m, "
       "ratio {:.4g}); mass per length {:.4g} kg/m^2 (real {:.4g})\n",
-      scene.plants, fmt::join(scene.plant_x(), ", "),
-      scene.blade == scenes::BladeModel::scaled ? "scaled" : "equivalent", double(scene.blade_length()),
+      scene.plants, fmt::join(scene.plant_x(), ", "), blade_name(scene.blade), double(scene.blade_length()),
       scene.blade_length_rows(), double(scene.blade_length() / scene.depth), double(scene.blade_thickness()),
       scene.blade_rows, double(m.density), double(m.youngs_modulus), double(m.poisson_ratio), double(m.bulk_modulus()),
       double(m.p_wave_speed()), double(scene.model_bending_stiffness()), double(scene.real_bending_stiffness()),
       double(scene.model_bending_stiffness() / scene.real_bending_stiffness()),
       double(m.density * scene.blade_thickness()), double(scene.real_density * scene.real_thickness));
+  if (scene.blade == scenes::BladeModel::rod) {
+    const auto b = scene.rod_blade();
+    fmt::print(
+        "rod blades: {} nodes (ds = {:.4f} m), t = {} m, E = {:.3g} Pa, rho = {} kg/m^3, E t^3/12 = {:.3g} N m, "
+        "rho t = {:.4g} kg/m^2 per unit width (the real blade's), clamped at the bed, buoyant in 1000 kg/m^3\n",
+        b.node_count(scene.dp()), double(b.length) / (b.node_count(scene.dp()) - 1), double(b.thickness),
+        double(b.youngs_modulus), double(b.density), double(b.bending_stiffness_per_width()),
+        double(b.mass_per_area()));
+  }
 
   CaseResult with, without;
-  if (o.run_plants) with = run_case<T, true>(o, o.out / "plants");
-  if (o.run_empty) without = run_case<T, false>(o, o.out / "empty");
+  if (o.run_plants)
+    with = scene.blade == scenes::BladeModel::rod ? run_case<T, Plants::rods>(o, o.out / "plants")
+                                                  : run_case<T, Plants::continuum>(o, o.out / "plants");
+  if (o.run_empty) without = run_case<T, Plants::none>(o, o.out / "empty");
   const bool have_empty = o.run_empty || !o.empty_from.empty();
   if (!o.run_empty && have_empty) {  // the empty flume of an earlier run at the same waves and resolution
     const auto table = io::read_csv(o.empty_from / "empty" / "wave_heights.csv");
@@ -304,22 +343,27 @@ int run(const Options& o) {
                  1e3 * with.tip_dx_mean[k], 1e3 * with.tip_dz_mean[k]);
     fmt::print(
         "plants run: {} + {} + {} particles, {} steps, {} solid sub-steps, {:.1f} s wall; max stretch {:.3f}, "
-        "fluid particles inside the blades (max) {}{}\n",
+        "fluid particles inside the blades (max) {}; fluid particles that crossed a rod blade {}; lowest rod node "
+        "{:.4f} m above the bed{}\n",
         with.fluid, with.wall, with.solid, with.steps, with.solid_sub_steps, with.wall_seconds, with.max_stretch,
-        with.fluid_inside_max, with.failure.empty() ? "" : "; FAILED: " + with.failure);
+        with.fluid_inside_max, with.crossings, with.lowest_node,
+        with.failure.empty() ? "" : "; FAILED: " + with.failure);
   }
   if (o.run_empty)
     fmt::print("empty run: {} + {} particles, {} steps, {:.1f} s wall{}\n", without.fluid, without.wall, without.steps,
                without.wall_seconds, without.failure.empty() ? "" : "; FAILED: " + without.failure);
-  io::CsvWriter summary(o.out / "summary.csv", {"run", "fluid", "wall", "solid", "steps", "solid_sub_steps", "wall_s",
-                                                "reached_s", "max_stretch", "fluid_inside_max", "failed"});
+  io::CsvWriter summary(o.out / "summary.csv",
+                        {"run", "fluid", "wall", "solid", "steps", "solid_sub_steps", "wall_s", "reached_s",
+                         "max_stretch", "fluid_inside_max", "failed", "rod_crossings", "rod_lowest_node"});
   if (o.run_plants)
     summary.write_row({1, double(with.fluid), double(with.wall), double(with.solid), double(with.steps),
                        double(with.solid_sub_steps), with.wall_seconds, with.reached, with.max_stretch,
-                       double(with.fluid_inside_max), with.failure.empty() ? 0.0 : 1.0});
+                       double(with.fluid_inside_max), with.failure.empty() ? 0.0 : 1.0, double(with.crossings),
+                       with.lowest_node});
   if (o.run_empty)
     summary.write_row({0, double(without.fluid), double(without.wall), 0, double(without.steps), 0,
-                       without.wall_seconds, without.reached, 1, 0, without.failure.empty() ? 0.0 : 1.0});
+                       without.wall_seconds, without.reached, 1, 0, without.failure.empty() ? 0.0 : 1.0, 0,
+                       std::numeric_limits<double>::quiet_NaN()});
   const std::string plot =
       fmt::format("/usr/bin/python3 {}/examples/posidonia_flume/plot.py {}", SPHFSI_SOURCE_DIR, o.out.string());
   std::fflush(stdout);
@@ -352,10 +396,18 @@ int main(int argc, char** argv) try {
   s.first_plant_x = cli.get_number("plant-x", 1.2, "centre line of the first plant, m");
   s.height_ratio = cli.get_number("height-ratio", 0.4, "blade length / depth (paper: 0.32 to 0.5)");
   const std::string blade =
-      cli.get("blade", "scaled", "blade model: scaled (paper Table 3) | equivalent (blows up: docs/posidonia.md)");
+      cli.get("blade", "rod",
+              "blade model: rod (the real blade, t = 0.1 mm) | scaled (paper Table 3) | equivalent (blows up: "
+              "docs/posidonia.md)");
   s.blade_rows = int(cli.get_number("blade-rows", 3, "particle rows across the blade"));
   s.equivalent_bulk_modulus =
       cli.get_number("bulk-modulus", 1e5, "bulk modulus of the equivalent blade, Pa (bending unaffected)");
+  s.rod_node_spacing = cli.get_number("rod-spacing", 0.5, "rod blade: node spacing / dp");
+  s.rod_added_mass = cli.get_number("added-mass", 1, "rod blade: added inertia per length and width / (rho_w dp)");
+  s.rod_load_smoothing = int(cli.get_number("load-smoothing", 2, "rod blade: passes of the load filter"));
+  s.rod_velocity_factor = cli.get("velocity-factor", "off", "rod blade: eq. 23 velocity factor on | off") == "on";
+  s.rod_repulsion =
+      cli.get_number("repulsion", 0, "rod blade: k of eq. 19, A = k c0^2 / h (0: stops 3 x the orbital velocity)");
   s.poisson_ratio = cli.get_number("poisson", 0.3, "Poisson ratio of the real and scaled blade");
   s.real_density = cli.get_number("real-density", 910, "density of the real blade, kg/m^3");
   s.real_youngs_modulus = cli.get_number("real-modulus", 4.7e8, "Young's modulus of the real blade, Pa");
@@ -366,13 +418,17 @@ int main(int argc, char** argv) try {
   o.waves_analysed = cli.get_number("waves", 4, "full-amplitude waves recorded at the last gauge");
   o.end_time = cli.get_number("end-time", 0, "end time, s (0: from the waves to analyse at the last gauge)");
   o.snapshots = cli.get_number("snapshots", 20, "VTK snapshots per run (0: none)");
-  const std::string precision = cli.get("precision", "float", "fluid scalar type: float | double");
+  std::string precision =
+      cli.get("precision", "auto", "scalar type: float | double | auto (double for the rod, float otherwise)");
   o.out = cli.get("output", "out/posidonia_flume", "output folder");
   o.empty_from = cli.get("empty-from", "", "with --runs plants: take the empty flume's heights from DIR/empty");
   if (!cli.finish()) return 0;
   if (blade == "equivalent") s.blade = scenes::BladeModel::equivalent;
   else if (blade == "scaled") s.blade = scenes::BladeModel::scaled;
-  else throw InputError(fmt::format("--blade '{}': valid are equivalent, scaled", blade));
+  else if (blade == "rod") s.blade = scenes::BladeModel::rod;
+  else throw InputError(fmt::format("--blade '{}': valid are rod, equivalent, scaled", blade));
+  // the rod's axial strains (1e-6) are below float's position resolution over a metre (6e-8 m on 5 mm edges)
+  if (precision == "auto") precision = s.blade == scenes::BladeModel::rod ? "double" : "float";
   if (runs != "both" && runs != "plants" && runs != "empty")
     throw InputError(fmt::format("--runs '{}': valid are both, plants, empty", runs));
   o.run_plants = runs != "empty" && !no_plants && s.plants > 0;

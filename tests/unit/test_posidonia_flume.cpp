@@ -1,8 +1,11 @@
 // Tests of the Posidonia flume scene (scenes/posidonia_flume.hpp): the blade models against the paper's Table 3
 // and the preserved quantities, and the plants placed in the flume (fluid left out exactly where the blades are,
-// the reflection clamp on the bed plane, input checks).
+// the reflection clamp on the bed plane, input checks); the real blades as rods (scenes/meadow.hpp): the 2D meadow
+// spacing, the blade from its flexural rigidity, the repulsion that stops a particle, the load filter, the
+// crossing counter.
 #include <sphfsi/eos/tait.hpp>
 #include <sphfsi/kernel/wendland_c2.hpp>
+#include <sphfsi/scenes/meadow.hpp>
 #include <sphfsi/scenes/posidonia_flume.hpp>
 #include <sphfsi/solid/total_lagrangian.hpp>
 
@@ -48,6 +51,7 @@ TEST_CASE("posidonia blade models: the paper's Table 3 and the preserved quantit
 TEST_CASE("posidonia flume: plants replace exactly the fluid in their cells; reflection clamp on the bed",
           "[posidonia]") {
   scenes::PosidoniaFlume<double> s;
+  s.blade = scenes::BladeModel::scaled;
   s.particles_per_depth = 10;  // dp = 2 cm
   s.absorber_start = 1.8;
   s.gauges = {0.6, 1.0, 1.3, 1.7};
@@ -94,6 +98,7 @@ TEST_CASE("posidonia flume: plants replace exactly the fluid in their cells; ref
 
 TEST_CASE("posidonia flume: invalid plants are rejected", "[posidonia]") {
   scenes::PosidoniaFlume<double> s;
+  s.blade = scenes::BladeModel::scaled;
   s.plants = 2;
   s.spacing = 0.04;  // blades 3 cm thick at dp = 1 cm: the reference supports would overlap
   CHECK_THROWS_AS(s.validate(), InputError);
@@ -104,4 +109,118 @@ TEST_CASE("posidonia flume: invalid plants are rejected", "[posidonia]") {
   s.height_ratio = 0.4;
   s.first_plant_x = 2.5;  // beyond the damping zone's entrance
   CHECK_THROWS_AS(s.validate(), InputError);
+}
+
+TEST_CASE("real blades: the 2D meadow spacing, E from EI, the repulsion that stops a particle", "[posidonia][meadow]") {
+  // Luhar et al. (2017): N = 7200 blades/m^2 of width b = 3 mm: frontal width per bed area N b = 21.6 1/m
+  CHECK_THAT(scenes::equivalent_blade_spacing(7200.0, 3e-3), WithinRel(1.0 / 21.6, 1e-14));
+  // EI = 7.5e-8 N m^2, b = 3 mm, t = 0.1 mm: E = 12 EI / (b t^3) = 3e8 Pa; E t^3 / 12 = EI / b per unit width
+  const double E = scenes::youngs_modulus_from_rigidity(7.5e-8, 3e-3, 1e-4);
+  CHECK_THAT(E, WithinRel(3e8, 1e-12));
+  scenes::ThinBlade<double> b;
+  b.youngs_modulus = E;
+  CHECK_THAT(b.bending_stiffness_per_width(), WithinRel(7.5e-8 / 3e-3, 1e-12));
+  CHECK_THAT(b.mass_per_area(), WithinRel(920 * 1e-4, 1e-12));
+  CHECK_THROWS_AS(scenes::equivalent_blade_spacing(0.0, 3e-3), InputError);
+  CHECK_THROWS_AS(scenes::youngs_modulus_from_rigidity(7.5e-8, -3e-3, 1e-4), InputError);
+  // k = (3/16) (u/c0)^2: the work of R = A (1 - q) / sqrt(q) from q = 1 to the blade (A = k c0^2 / h, d = 2 h q),
+  // integrated here by the midpoint rule in s = sqrt(q) (dq = 2 s ds), equals u^2 / 2
+  const double u = 0.35, c0 = 8.8, h = 0.02;
+  const double k = scenes::repulsion_strength_to_stop(u, c0), A = k * c0 * c0 / h;
+  double work = 0;
+  const int n = 100000;
+  for (int i = 0; i < n; ++i) {
+    const double s_mid = (i + 0.5) / n, q = s_mid * s_mid;
+    work += A * (1 - q) / s_mid * 2 * s_mid * (1.0 / n) * 2 * h;
+  }
+  CHECK_THAT(work, WithinRel(0.5 * u * u, 1e-8));
+}
+
+TEST_CASE("posidonia rod plants: the real blade on lattice lines, no fluid removed", "[posidonia][meadow]") {
+  scenes::PosidoniaFlume<double> s;
+  REQUIRE(s.blade == scenes::BladeModel::rod);  // the default
+  s.particles_per_depth = 10;                   // dp = 2 cm
+  s.absorber_start = 1.8;
+  s.plants = 3;
+  s.spacing = 0.12;
+  const double dp = s.dp();
+  auto empty_scene = s;
+  empty_scene.plants = 0;
+  System empty(scenes::wave_flume_domain(empty_scene.flume()), Tait<double>(1000, empty_scene.flume().sound_speed()));
+  const auto empty_layout = scenes::build_posidonia_flume(empty, empty_scene);
+
+  const auto g = s.flume();
+  System system(scenes::wave_flume_domain(g), Tait<double>(1000, g.sound_speed()));
+  const auto layout = scenes::build_posidonia_flume(system, s);
+  CHECK(layout.flume.fluid_particles == empty_layout.flume.fluid_particles);
+  const auto rods = scenes::add_posidonia_rods(system, s, layout);
+  REQUIRE(rods.size() == 3);
+  const auto& p = system.particles();
+  for (std::size_t k = 0; k < rods.size(); ++k) {
+    const auto& rod = rods.rod(k);
+    // per unit width: bending stiffness E t^3 / 12 and mass rho t l of the real blade, exactly
+    CHECK_THAT(rod.bending_stiffness(), WithinRel(4.7e8 * 1e-12 / 12, 1e-12));
+    double mass = 0;
+    for (double m : rod.node_masses()) mass += m;
+    CHECK_THAT(mass, WithinRel(910 * 1e-4 * s.blade_length(), 1e-12));
+    const auto& X = rod.reference_positions();
+    CHECK_THAT(X.front()[1], Catch::Matchers::WithinAbs(0.0, 1e-15));
+    CHECK_THAT(X.back()[1], WithinRel(s.blade_length(), 1e-12));
+    CHECK_THAT(X.front()[0] / dp, Catch::Matchers::WithinAbs(std::round(X.front()[0] / dp), 1e-9));  // lattice line
+  }
+  // the nearest fluid particles stand half a spacing beside the blades
+  double closest = 1e9;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (p.kind[i] != Kind::solid) continue;
+    for (std::size_t j = 0; j < p.size(); ++j)
+      if (p.kind[j] == Kind::fluid) closest = std::min(closest, (p.position[i] - p.position[j]).norm());
+  }
+  CHECK_THAT(closest, WithinRel(0.5 * dp, 1e-9));
+  s.spacing = 1.5 * dp;  // fewer than two fluid columns between rods
+  CHECK_THROWS_AS(s.validate(), InputError);
+}
+
+TEST_CASE("rod blades: the load filter keeps the total force and removes the node-scale zigzag; crossings counted",
+          "[posidonia][meadow]") {
+  using V = Vec<2, double>;
+  System system(Domain<2, double>(V(-0.2, -0.2), V(0.2, 0.3)), Tait<double>(1000, 10));
+  scenes::ThinBlade<double> blade;
+  blade.length = 0.1;
+  blade.clamped_height = 0;
+  const double dp = 0.01;
+  scenes::RodBladeCoupling<double> how;
+  how.load_smoothing_passes = 2;
+  auto rods = scenes::add_rod_blades(system, {0.0}, 0.0, blade, dp, 1.3 * dp, 1, how);
+  auto& p = system.particles();
+  const auto& ids = rods.rod(0).particle_ids();
+  REQUIRE(ids.size() == 21);
+  V total = V::Zero();
+  for (std::size_t k = 0; k < ids.size(); ++k) {  // a zigzag load plus a uniform one
+    const std::size_t s = p.slot_of_id(ids[k]);
+    p.acceleration[s] = V((k % 2 == 0 ? 1.0 : -1.0) + 0.25, 0) / p.mass[s];
+    total += p.mass[s] * p.acceleration[s];
+  }
+  system.update_neighbors();
+  rods.compute_rates(system, 0.0);  // no fluid: the coupling adds nothing, the filter acts
+  V after = V::Zero();
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    const std::size_t s = p.slot_of_id(ids[k]);
+    after += p.mass[s] * p.acceleration[s];
+    // two passes of 1/4 1/2 1/4 map (-1)^k to 0 away from the ends: only the uniform part is left
+    if (k >= 2 && k + 2 < ids.size()) CHECK_THAT(p.mass[s] * p.acceleration[s][0], WithinRel(0.25, 1e-12));
+  }
+  CHECK_THAT(after[0], WithinRel(total[0], 1e-12));
+
+  // a fluid particle beside the blade that moves to the other face is one crossing; one that passes over the tip
+  // is none
+  const std::size_t f = p.add(Kind::fluid, V(-0.005, 0.05), V::Zero(), 1000, 0.1, 1.3 * dp);
+  scenes::BladeCrossingCounter<System> counter(1.5 * dp);
+  CHECK(counter.update(system, rods) == 0);
+  p.position[p.slot_of_id(p.id[f])] = V(0.005, 0.05);
+  CHECK(counter.update(system, rods) == 1);
+  p.position[p.slot_of_id(p.id[f])] = V(0.0, 0.11);  // above the tip
+  CHECK(counter.update(system, rods) == 0);
+  p.position[p.slot_of_id(p.id[f])] = V(-0.005, 0.09);
+  CHECK(counter.update(system, rods) == 0);
+  CHECK(counter.total() == 1);
 }

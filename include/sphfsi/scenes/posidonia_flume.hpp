@@ -23,13 +23,19 @@
 //               takes its bulk modulus from `equivalent_bulk_modulus` (near incompressible), which changes
 //               neither its bending stiffness (E) nor its mass. With the explicit repulsive-force coupling this
 //               blade blows up within the first 0.03 s (too light: added-mass instability; too soft: G below the
-//               fluid's pressure noise), measured in docs/posidonia.md; `scaled` is the default.
-// In 2D both are plane strain: the bending stiffness per unit width is E_m t_m^3 / (12 (1 - nu_m^2)).
+//               fluid's pressure noise), measured in docs/posidonia.md.
+//   rod:        the real blade itself (t = 0.1 mm, E, rho), one line of rod nodes (solid/elastic_rod.hpp) per plant
+//               from the bed to l, clamped at the bed, pushed on both faces by the repulsive force
+//               (scenes/meadow.hpp): bending stiffness E t^3 / 12 and mass rho t per unit width exactly (issue 5.4),
+//               no fluid left out (the blade is a line between two fluid columns). The default.
+// In 2D scaled and equivalent are plane strain: the bending stiffness per unit width is E_m t_m^3 / (12 (1 - nu_m^2));
+// the rod bends as a beam with E (a seagrass blade is narrow).
 #pragma once
 
 #include <sphfsi/core/error.hpp>
 #include <sphfsi/core/particle_system.hpp>
 #include <sphfsi/scenes/builders.hpp>
+#include <sphfsi/scenes/meadow.hpp>
 #include <sphfsi/scenes/wave_flume.hpp>
 #include <sphfsi/solid/elastic_material.hpp>
 
@@ -39,7 +45,7 @@
 
 namespace sphfsi::scenes {
 
-enum class BladeModel { equivalent, scaled };
+enum class BladeModel { equivalent, scaled, rod };
 
 /// The Posidonia flume: waves, resolution, plants and blade model (lengths in m).
 template <Real T>
@@ -56,19 +62,24 @@ struct PosidoniaFlume {
   T damping_rate{T(10)};                                  ///< beta, 1/s
   std::vector<T> gauges{T(0.6), T(1.0), T(1.3), T(1.7)};  ///< gauge positions, m
   // plants
-  int plants{1};                         ///< number of plants (0: the empty flume)
-  T first_plant_x{T(1.2)};               ///< centre line of the first (upstream) plant, m
-  T spacing{T(0.1)};                     ///< distance between neighbouring plants, m
-  T height_ratio{T(0.4)};                ///< blade length / depth, [0.1, 0.9] (paper: 0.32 to 0.5)
-  BladeModel blade{BladeModel::scaled};  ///< default scaled: the equivalent blade does not run (docs/posidonia.md)
-  int blade_rows{3};                     ///< particle rows across the blade (>= 3: the normal needs them)
-  int clamp_rows{3};                     ///< rows embedded below the bed (the reflection clamp's images)
+  int plants{1};                      ///< number of plants (0: the empty flume)
+  T first_plant_x{T(1.2)};            ///< centre line of the first (upstream) plant, m
+  T spacing{T(0.1)};                  ///< distance between neighbouring plants, m
+  T height_ratio{T(0.4)};             ///< blade length / depth, [0.1, 0.9] (paper: 0.32 to 0.5)
+  BladeModel blade{BladeModel::rod};  ///< rod: the real blade (the equivalent continuum does not run)
+  int blade_rows{3};                  ///< particle rows across the blade (>= 3: the normal needs them)
+  int clamp_rows{3};                  ///< rows embedded below the bed (the reflection clamp's images)
   // the real blade (Table 3)
   T real_density{T(910)};             ///< kg/m^3
   T real_youngs_modulus{T(4.7e8)};    ///< Pa
   T real_thickness{T(1e-4)};          ///< m
   T poisson_ratio{T(0.3)};            ///< nu from K and E of Table 3 (scaled blade and real blade)
   T equivalent_bulk_modulus{T(1e5)};  ///< least K of the equivalent blade, Pa (50x the bed pressure rho g h)
+  T rod_node_spacing{T(0.5)};         ///< rod blade: node spacing / dp
+  T rod_added_mass{T(1)};             ///< rod blade: added inertia per length and width / (rho_w dp) (meadow.hpp)
+  int rod_load_smoothing{2};          ///< rod blade: passes of the load filter along the blade (meadow.hpp)
+  bool rod_velocity_factor{false};    ///< rod blade: eq. 23's velocity factor in the coupling
+  T rod_repulsion{T(0)};              ///< rod blade: k of eq. 19 (0: to stop 3 x the surface orbital velocity)
 
   void validate() const {
     require_positive("PosidoniaFlume::depth (m)", depth);
@@ -85,28 +96,33 @@ struct PosidoniaFlume {
     if (!gauges.empty())
       for (T x : gauges) require_in_range("PosidoniaFlume gauge position (m)", x, T(0), absorber_start);
     if (plants > 0) {
-      if (blade_length_rows() < clamp_rows)
+      if (blade != BladeModel::rod && blade_length_rows() < clamp_rows)
         throw InputError(
             fmt::format("PosidoniaFlume: the blade has {} rows above the bed (height_ratio {} at h/dp = "
                         "{}), fewer than the {} embedded rows it must mirror: raise height_ratio or h/dp",
                         blade_length_rows(), height_ratio, particles_per_depth, clamp_rows));
       require_in_range("PosidoniaFlume::first_plant_x (m)", first_plant_x, T(4) * dp(), absorber_start);
       const T last = first_plant_x + T(plants - 1) * spacing;
-      if (plants > 1)
+      if (plants > 1 && blade != BladeModel::rod)
         require_in_range("PosidoniaFlume::spacing (m, plants' reference supports must not overlap)", spacing,
                          blade_thickness() + T(3) * dp(), T(10) * depth);
+      if (plants > 1 && blade == BladeModel::rod)
+        require_in_range("PosidoniaFlume::spacing (m, at least two fluid columns between rod blades)", spacing,
+                         T(2) * dp(), T(10) * depth);
       require_in_range("PosidoniaFlume last plant x (m)", last, first_plant_x, absorber_start);
     }
   }
 
   T dp() const { return depth / particles_per_depth; }
-  T blade_thickness() const { return T(blade_rows) * dp(); }  ///< t_m, m
+  /// t_m, m (the rod: the real thickness)
+  T blade_thickness() const { return blade == BladeModel::rod ? real_thickness : T(blade_rows) * dp(); }
   int blade_length_rows() const { return std::max(1, int(std::lround(height_ratio * depth / dp()))); }
   T blade_length() const { return T(blade_length_rows()) * dp(); }  ///< l (rounded to whole rows), m
-  /// Centre line of each plant, snapped to the fluid lattice ((i + 1/2) dp) shifted by dp/2 for even row counts.
+  /// Centre line of each plant, snapped to the fluid lattice ((i + 1/2) dp) shifted by dp/2 for even row counts;
+  /// a rod blade stands on a lattice line i dp, between two fluid columns.
   std::vector<T> plant_x() const {
     std::vector<T> x;
-    const T d = dp(), shift = blade_rows % 2 == 0 ? T(0.5) * d : T(0);
+    const T d = dp(), shift = blade_rows % 2 == 0 || blade == BladeModel::rod ? T(0.5) * d : T(0);
     for (int i = 0; i < plants; ++i) {
       const T want = first_plant_x + T(i) * spacing;
       x.push_back((std::floor((want - shift) / d) + T(0.5)) * d + shift);
@@ -116,8 +132,9 @@ struct PosidoniaFlume {
 
   /// The real blade's material (plane strain in 2D would need E' = E / (1 - nu^2)).
   ElasticMaterial<T> real_material() const { return {real_density, real_youngs_modulus, poisson_ratio}; }
-  /// The modelled blade's material at thickness t_m (see the header comment).
+  /// The modelled blade's material at thickness t_m (see the header comment; the rod: the real material).
   ElasticMaterial<T> blade_material() const {
+    if (blade == BladeModel::rod) return real_material();
     const T ratio = real_thickness / blade_thickness();  // t / t_m
     if (blade == BladeModel::scaled) return {real_density, real_youngs_modulus * ratio, poisson_ratio};
     const T E = real_youngs_modulus * ratio * ratio * ratio;
@@ -125,8 +142,10 @@ struct PosidoniaFlume {
     // bulk modulus raised to at least equivalent_bulk_modulus: nu from K = E / (3 (1 - 2 nu))
     return {real_density * ratio, E, std::max(poisson_ratio, T(0.5) - E / (T(6) * equivalent_bulk_modulus))};
   }
-  /// Bending stiffness per unit width of the model blade in plane strain, E_m t_m^3 / (12 (1 - nu_m^2)), N m.
+  /// Bending stiffness per unit width of the model blade in plane strain, E_m t_m^3 / (12 (1 - nu_m^2)), N m; the
+  /// rod: E t^3 / 12 (beam bending).
   T model_bending_stiffness() const {
+    if (blade == BladeModel::rod) return rod_blade().bending_stiffness_per_width();
     const auto m = blade_material();
     const T t = blade_thickness();
     return m.plane_strain_modulus() * t * t * t / T(12);
@@ -134,6 +153,19 @@ struct PosidoniaFlume {
   /// Bending stiffness per unit width of the real blade, E t^3 / 12, N m.
   T real_bending_stiffness() const {
     return real_youngs_modulus * real_thickness * real_thickness * real_thickness / T(12);
+  }
+
+  /// The real blade as a rod of length l (the same whole rows of dp as the continuum blades), clamped at the bed.
+  ThinBlade<T> rod_blade() const {
+    ThinBlade<T> b;
+    b.length = blade_length();
+    b.clamped_height = T(0);
+    b.thickness = real_thickness;
+    b.density = real_density;
+    b.youngs_modulus = real_youngs_modulus;
+    b.poisson_ratio = poisson_ratio;
+    b.node_spacing_ratio = rod_node_spacing;
+    return b;
   }
 
   /// The flume: piston, damping zone from absorber_start over damping_wavelengths, fluid left out of the plants.
@@ -152,7 +184,8 @@ struct PosidoniaFlume {
     g.damping_rate = damping_rate;
     g.absorber = FlumeAbsorber::damping_zone;
     const T half = T(0.5) * blade_thickness(), top = blade_length();
-    for (T x : plant_x()) g.fluid_exclusions.push_back({Vec<2, T>(x - half, T(0)), Vec<2, T>(x + half, top)});
+    if (blade != BladeModel::rod)
+      for (T x : plant_x()) g.fluid_exclusions.push_back({Vec<2, T>(x - half, T(0)), Vec<2, T>(x + half, top)});
     return g;
   }
 };
@@ -169,6 +202,7 @@ struct PosidoniaLayout {
 
 /// Fills `system` (empty, on wave_flume_domain(scene.flume())) with the flume and the plants (solid body
 /// plant_body). The caller creates the solid model and clamps it with clamp_by_reflection(0, +z) on the bed.
+/// For BladeModel::rod only the flume is built (and plant_x set): add the blades with add_posidonia_rods.
 template <class System>
 PosidoniaLayout<typename System::scalar_type> build_posidonia_flume(
     System& system, const PosidoniaFlume<typename System::scalar_type>& scene) {
@@ -183,6 +217,7 @@ PosidoniaLayout<typename System::scalar_type> build_posidonia_flume(
   const Resolution<T> res{dp, g.smoothing_ratio};
   const auto material = scene.blade_material();
   const T mass = material.density * dp * dp;
+  if (scene.blade == BladeModel::rod) return out;
   for (T xc : out.plant_x) {
     std::vector<std::uint32_t> tip;
     // the blade (z in (0, l)) and its embedded image rows (z in (-clamp_rows dp, 0)), one lattice
@@ -195,6 +230,25 @@ PosidoniaLayout<typename System::scalar_type> build_posidonia_flume(
     out.tips.push_back(std::move(tip));
   }
   return out;
+}
+
+/// The rod plants of a flume built by build_posidonia_flume (bodies plant_body, plant_body + 1, ...), clamped at
+/// the bed; `how` sets the coupling (default: RodBladeCoupling's).
+template <class System>
+RodBlades<System> add_posidonia_rods(System& system, const PosidoniaFlume<typename System::scalar_type>& scene,
+                                     const PosidoniaLayout<typename System::scalar_type>& layout,
+                                     RodBladeCoupling<typename System::scalar_type> how = {}) {
+  using T = typename System::scalar_type;
+  const WaveFlumeGeometry<T> g = scene.flume();
+  how.added_mass_ratio = scene.rod_added_mass;
+  how.load_smoothing_passes = scene.rod_load_smoothing;
+  how.coupling.velocity_factor = scene.rod_velocity_factor;
+  if (scene.rod_repulsion > T(0)) how.coupling.strength = scene.rod_repulsion;
+  else how.stopping_speed = T(3) * waves::Wavemaker<T>(g.wave).wave().surface_orbital_velocity(scene.wave_height);
+  if (scene.blade != BladeModel::rod)
+    throw InputError("add_posidonia_rods: the scene's blade model is not BladeModel::rod");
+  return add_rod_blades(system, layout.plant_x, T(0), scene.rod_blade(), scene.dp(), g.smoothing_ratio * scene.dp(),
+                        layout.plant_body, how);
 }
 
 }  // namespace sphfsi::scenes

@@ -20,7 +20,9 @@
 //   f_j += N_j e_j / l_j + tau_j e_j^perp / l_j^2,   f_{j+1} -= the same,
 // and the equation of motion is
 //   m_i dv_i/dt = f_i + m_i [(1 - rho_w / rho) g + a_ext,i] - c_d m_i v_i
-// (buoyancy of the surrounding fluid of density rho_w; a_ext from the couplings; c_d optional, for static runs).
+// (buoyancy of the surrounding fluid of density rho_w; a_ext from the couplings; c_d optional, for static runs);
+// with an added inertia m_a per unit area (ElasticRodParameters::added_mass_per_area) the left side is
+// (m_i + m_a b D_i) dv_i/dt, the forces unchanged (the step bound above stays valid: the frequencies only drop).
 // Every edge force is an equal and opposite pair and sum_j tau_j telescopes to M_0 - M_{n-1} = 0 for free ends: a
 // free rod conserves linear and angular momentum, and U is invariant under rigid motions (no internal force).
 // The clamp half cell D_0 = L_0/2 makes the static tip deflection under a tip load the trapezoidal rule of
@@ -84,6 +86,11 @@ struct ElasticRodParameters {
   bool sub_cycle{true};                          ///< true: advance() sub-cycles, no limit on the outer step
   T damping{T(0)};                               ///< c_d, mass-proportional damping, 1/s, >= 0 (0: dynamics)
   T stretch_limit{T(0)};                         ///< BlowUpError above this edge stretch (0: off), else > 1
+  /// Extra inertia per unit length and width m_a (kg/m^2, like rho t), e.g. part of the surrounding fluid's added
+  /// mass: node i moves with m_i + m_a b D_i under the forces on m_i (elastic, body force, couplings). It
+  /// stabilises the explicit coupling of a blade far lighter than the fluid particles it displaces
+  /// (scenes/meadow.hpp). >= 0; 0: the blade's own mass only.
+  T added_mass_per_area{T(0)};
 
   void validate() const {
     section.validate();
@@ -91,6 +98,7 @@ struct ElasticRodParameters {
     require_non_negative("ElasticRodParameters::ambient_density (rho_w, kg/m^3)", ambient_density);
     require_in_range("ElasticRodParameters::cfl", cfl, T(1e-6), T(1));
     require_non_negative("ElasticRodParameters::damping (c_d, 1/s)", damping);
+    require_non_negative("ElasticRodParameters::added_mass_per_area (m_a, kg/m^2)", added_mass_per_area);
     if (stretch_limit != T(0))
       require_in_open_range("ElasticRodParameters::stretch_limit", stretch_limit, T(1), std::numeric_limits<T>::max());
   }
@@ -185,6 +193,9 @@ class ElasticRod {
     const T rho_a = material_.density * params_.section.area();
     mass_.resize(n);
     for (std::size_t i = 0; i < n; ++i) mass_[i] = rho_a * voronoi_[i];
+    inertia_ratio_.resize(n);
+    for (std::size_t i = 0; i < n; ++i)
+      inertia_ratio_[i] = rho_a / (rho_a + params_.added_mass_per_area * params_.section.width);
     rest_angle_.assign(n, T(0));
     for (std::size_t i = 1; i + 1 < n; ++i) rest_angle_[i] = turning_angle(X_[i] - X_[i - 1], X_[i + 1] - X_[i]);
     held_.assign(n, 0);
@@ -285,7 +296,7 @@ class ElasticRod {
           v_[k] = u;
           continue;
         }
-        v_[k] += T(0.5) * h * (a_int_[k] + a_ext_[k] + g);
+        v_[k] += (T(0.5) * h * inertia_ratio_[k]) * (a_int_[k] + a_ext_[k] + g);
         x_[k] += h * v_[k];
         if (has_contact_ && (X_[k] - contact_point_).dot(contact_normal_) >= contact_gap_) {
           const T d = (x_[k] - contact_point_).dot(contact_normal_);
@@ -298,7 +309,7 @@ class ElasticRod {
       }
       internal_forces();
       for (std::size_t k = 0; k < n; ++k)
-        if (!held_[k]) v_[k] += T(0.5) * h * (a_int_[k] + a_ext_[k] + g);
+        if (!held_[k]) v_[k] += (T(0.5) * h * inertia_ratio_[k]) * (a_int_[k] + a_ext_[k] + g);
       check_finite(time + T(s + 1) * h);
     }
     sub_steps_ += n_sub;
@@ -551,6 +562,7 @@ class ElasticRod {
   std::vector<T> rest_length_;                     // L_j, m
   std::vector<T> voronoi_;                         // D_i, m
   std::vector<T> mass_;                            // m_i = rho A D_i, kg
+  std::vector<T> inertia_ratio_;                   // m_i / (m_i + m_a b D_i) (1 without added mass)
   std::vector<T> rest_angle_;                      // phi0_i, rad
   std::vector<std::uint8_t> held_;                 // 1: node held at rest at X
   std::array<bool, 2> clamped_end_{false, false};  // base, tip: tangent held
