@@ -60,7 +60,9 @@ struct ParticleSet {
   /// Appends one particle with the next unused id and returns its slot (== its id until the first re-sort or
   /// removal). x and v may be elements of this set.
   std::size_t add(Kind k, const Vector& x_in, const Vector& v_in, T rho, T m, T h, std::int32_t body_index = -1) {
-    const Vector x = x_in, v = v_in;  // copies: x_in, v_in may be elements of this set, and the arrays reallocate
+    // Copies on purpose: x_in and v_in may be elements of this set, whose arrays reallocate below.
+    const Vector x = x_in;  // NOLINT(performance-unnecessary-copy-initialization)
+    const Vector v = v_in;  // NOLINT(performance-unnecessary-copy-initialization)
     require_positive("particle density rho (kg/m^3)", rho);
     require_positive("particle mass m (kg)", m);
     require_positive("particle smoothing length h (m)", h);
