@@ -459,4 +459,29 @@ TEMPLATE_TEST_CASE("multi-level search: candidates per particle against the sing
            << " neighbours");
   CHECK(not_subset == 0);
   CHECK(ratio < 0.5);
+
+  // Here the coarse particles more than a level-0 cell from any fine one keep the single grid's rows
+  // (needs_levels() false; about 3/4 of the coarse particles, a fifth (2D) or a ninth (3D) of all: asserted, more
+  // than 1/20 and less than 1/2, so that both paths are exercised), the others use the levels: both must find
+  // exactly the brute-force neighbours, and each pair once.
+  std::size_t single_grid_particles = 0;
+  for (std::size_t a = 0; a < n; ++a) single_grid_particles += !system.levels().needs_levels(a);
+  CAPTURE(single_grid_particles);
+  CHECK(single_grid_particles > n / 20);
+  CHECK(single_grid_particles < n / 2);
+  const auto expected = brute_force_neighbours(system);
+  const auto found = cell_list_neighbours(system);
+  CHECK(found == expected);
+  std::set<std::pair<std::uint32_t, std::uint32_t>> once;
+  std::size_t repeated = 0, outside = 0;
+  for (std::size_t a = 0; a < n; ++a) {
+    const std::size_t end = system.neighbor_once_end(a);
+    system.for_each_neighbor_once(a, [&](std::size_t b, const Vector&, T, T) {
+      outside += b <= a || b >= end;
+      repeated += !once.emplace(std::min(p.id[a], p.id[b]), std::max(p.id[a], p.id[b])).second;
+    });
+  }
+  CHECK(repeated == 0);
+  CHECK(outside == 0);
+  CHECK(once == unordered_pairs(expected));
 }
