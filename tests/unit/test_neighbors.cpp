@@ -49,6 +49,23 @@ std::vector<std::set<std::uint32_t>> brute_force_neighbours(const System& system
   return sets;
 }
 
+/// Checks that the search found exactly the brute-force sets (by id), and that they are not vacuous: several
+/// neighbours per particle on average.
+inline void check_same_neighbours(const std::vector<std::set<std::uint32_t>>& found,
+                                  const std::vector<std::set<std::uint32_t>>& expected) {
+  const std::size_t n = expected.size();
+  std::size_t missed = 0, spurious = 0, pairs = 0;
+  for (std::size_t id = 0; id < n; ++id) {
+    pairs += expected[id].size();
+    for (std::uint32_t j : expected[id]) missed += !found[id].count(j);
+    for (std::uint32_t j : found[id]) spurious += !expected[id].count(j);
+  }
+  CAPTURE(pairs);
+  CHECK(pairs > 3 * n);
+  CHECK(missed == 0);
+  CHECK(spurious == 0);
+}
+
 /// Neighbour sets by id as ParticleSystem::for_each_neighbor reports them; also checks the arguments it passes.
 template <class System>
 std::vector<std::set<std::uint32_t>> cell_list_neighbours(const System& system) {
@@ -181,17 +198,7 @@ TEMPLATE_TEST_CASE("cell list finds exactly the brute-force neighbour sets", "[n
       out_of_order += cell_key(p.position[i], domain, cell_size) < cell_key(p.position[i - 1], domain, cell_size);
     CHECK(out_of_order == 0);
 
-    const auto found = cell_list_neighbours(system);
-    std::size_t missed = 0, spurious = 0, pairs = 0;
-    for (std::uint32_t id = 0; id < n; ++id) {
-      pairs += expected[id].size();
-      for (std::uint32_t j : expected[id]) missed += !found[id].count(j);
-      for (std::uint32_t j : found[id]) spurious += !expected[id].count(j);
-    }
-    CAPTURE(pairs);
-    CHECK(pairs > 3 * n);  // not vacuous: several neighbours per particle on average
-    CHECK(missed == 0);
-    CHECK(spurious == 0);
+    check_same_neighbours(cell_list_neighbours(system), expected);
 
     // Second pass: shuffle the storage order (as if particles had moved) and search again.
     std::vector<std::uint32_t> order(n);
@@ -361,17 +368,7 @@ TEMPLATE_TEST_CASE("multi-level search finds exactly the brute-force neighbours 
       out_of_order += cell_key(p.position[i], domain, coarse_cell) < cell_key(p.position[i - 1], domain, coarse_cell);
     CHECK(out_of_order == 0);
 
-    const auto found = cell_list_neighbours(system);
-    std::size_t missed = 0, spurious = 0, total = 0;
-    for (std::uint32_t id = 0; id < n; ++id) {
-      total += expected[id].size();
-      for (std::uint32_t j : expected[id]) missed += !found[id].count(j);
-      for (std::uint32_t j : found[id]) spurious += !expected[id].count(j);
-    }
-    CAPTURE(total);
-    CHECK(total > 3 * n);
-    CHECK(missed == 0);
-    CHECK(spurious == 0);
+    check_same_neighbours(cell_list_neighbours(system), expected);
 
     // Each pair once, from the smaller slot, below neighbor_once_end.
     std::set<std::pair<std::uint32_t, std::uint32_t>> once;
