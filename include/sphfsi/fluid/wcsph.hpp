@@ -27,6 +27,10 @@
 //     pressure and viscosity sums; their density is kept >= rho0 so walls never attract fluid.
 //   repulsive walls (Monaghan & Kos 1999, with Rogers & Dalrymple 2008): see boundary/repulsive_force.hpp;
 //     wall particles only push the fluid along their normal and take no part in the SPH sums.
+// Thin structures (one line of nodes, e.g. solid/elastic_rod.hpp) publish their edges (Simulation collects them from
+// its models); with FluidParameters::thin_structure_visibility, fluid and wall pairs whose segment crosses an edge
+// do not interact (fluid/thin_structure_visibility.hpp), so the fluid on one face does not feel the other face
+// through the SPH sums. 2D only.
 // Solid particles are skipped here: a coupling policy owns fluid-solid pairs. Contract with the solid models:
 // compute_rates() zeroes the acceleration of solid particles; couplings (ParticleModels evaluated after the
 // fluid) add the fluid-on-solid force per unit mass there; the solid model adds its internal forces and gravity
@@ -37,6 +41,7 @@
 #include <sphfsi/core/error.hpp>
 #include <sphfsi/core/parallel.hpp>
 #include <sphfsi/core/types.hpp>
+#include <sphfsi/fluid/thin_structure_visibility.hpp>
 #include <sphfsi/kernel/concepts.hpp>
 
 #include <Eigen/LU>
@@ -85,6 +90,9 @@ struct FluidParameters {
   /// Fluid pressure floor, Pa (-inf: none). 0 stops spray clusters from collapsing under negative pressure
   /// (tensile instability, Swegle et al. 1995): water in a thin jet cannot sustain tension.
   T minimum_pressure{-std::numeric_limits<T>::infinity()};
+  /// Pairs whose segment crosses an edge of a thin structure (WcsphFluid::set_structure_edges) do not interact
+  /// (true); false: the published edges are ignored and the fluid interacts through the structure in its sums.
+  bool thin_structure_visibility{true};
 
   void validate() const {
     for (int d = 0; d < Dim; ++d) require_finite("FluidParameters::gravity", gravity[d]);
@@ -117,6 +125,15 @@ class WcsphFluid {
   /// Restores the signal speeds saved with signal_speeds() (io/checkpoint.hpp).
   void restore_signal_speeds(std::vector<T> speeds) { signal_speed_ = std::move(speeds); }
 
+  /// Edges of thin structures (pairs of node ids) that hide fluid and wall pairs from each other (2D; see the
+  /// header comment and FluidParameters::thin_structure_visibility). An empty list removes them.
+  void set_structure_edges(std::vector<StructureEdge> edges) {
+    if (Dim != 2 && !edges.empty())
+      throw InputError("WcsphFluid::set_structure_edges: thin-structure visibility is 2D only (valid: Dim = 2)");
+    visibility_.set_edges(std::move(edges));
+  }
+  const ThinStructureVisibility<T>& structure_visibility() const noexcept { return visibility_; }
+
   /// Overwrites acceleration, density_rate and xsph_velocity of fluid and wall particles
   /// (pressure and sound speed must be current: System::update_pressure(), neighbours too:
   /// System::update_neighbors()).
@@ -139,6 +156,11 @@ class WcsphFluid {
       volume_[a] = p.mass[a] / p.density[a];                              // m^3 (m^2 in 2D)
     });
     if (params_.gradient_correction != GradientCorrection::none) update_gradient_correction(system);
+    occluded_ = false;
+    if constexpr (Dim == 2) {
+      occluded_ = params_.thin_structure_visibility && visibility_.active();
+      if (occluded_) visibility_.update(system);
+    }
     // A few slot ranges per thread, handed out dynamically: wall particles cost less than fluid ones, and on a
     // shared machine a thread may be descheduled for a while.
     const std::size_t threads = static_cast<std::size_t>(std::max(1, thread_count()));
@@ -371,6 +393,9 @@ class WcsphFluid {
       const Kind kb = kind[b];
       const bool fluid_b = kb == Kind::fluid;
       if (kb == Kind::solid || !(fluid_a || fluid_b)) return;  // wall-wall pairs do not interact
+      if constexpr (Dim == 2) {  // hidden from each other by a thin structure
+        if (occluded_ && (visibility_.near(a) || visibility_.near(b)) && visibility_.blocks(a, b, xa, x[b])) return;
+      }
       const Vector vab = va - v[b];
       if (!dynamic_walls && !(fluid_a && fluid_b)) {  // repulsive wall: pushes the fluid particle only
         if (fluid_a)
@@ -446,6 +471,8 @@ class WcsphFluid {
   std::vector<Spill> spills_;             // one per slot range
   std::vector<Mat<Dim, T>> correction_;   // L_a per slot (valid where corrected_[a])
   std::vector<unsigned char> corrected_;  // 1: slot a uses the corrected pressure gradient
+  ThinStructureVisibility<T> visibility_;  // edges of thin structures (2D)
+  bool occluded_{false};                   // this evaluation applies the visibility criterion
 };
 
 }  // namespace sphfsi

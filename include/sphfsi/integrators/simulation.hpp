@@ -184,6 +184,7 @@ class Simulation {
 
   /// Neighbours, pressure, fluid and wall rates, then each model's rates, at time t.
   void evaluate_rates(T t) {
+    if (!edges_collected_) collect_structure_edges();
     system_.update_neighbors(t);
     system_.update_pressure();
     if (const T p_min = fluid_.parameters().minimum_pressure; p_min > -std::numeric_limits<T>::infinity()) {
@@ -255,6 +256,22 @@ class Simulation {
   }
 
  private:
+  /// Models with thin structures (`structure_edges(std::vector<StructureEdge>&) const`) publish their edges once;
+  /// the fluid hides pairs across them (fluid/thin_structure_visibility.hpp).
+  void collect_structure_edges() {
+    edges_collected_ = true;
+    std::vector<StructureEdge> edges;
+    std::apply(
+        [&](const auto&... m) {
+          const auto append = [&](const auto& model) {
+            if constexpr (requires { model.structure_edges(edges); }) model.structure_edges(edges);
+          };
+          (append(m), ...);
+        },
+        models_);
+    if (!edges.empty()) fluid_.set_structure_edges(std::move(edges));
+  }
+
   void record_reference_positions() {
     const auto& p = system_.particles();
     reference_position_.resize(p.id_capacity());  // indexed by id
@@ -330,6 +347,7 @@ class Simulation {
   std::size_t steps_{0};
   bool initialised_{false};
   bool mach_warned_{false};
+  bool edges_collected_{false};
   T expected_speed_{0};  // m/s, 0: estimate sqrt(g D)
   std::function<void(const std::string&)> warn_ = [](const std::string& message) {
     std::fprintf(stderr, "warning: %s\n", message.c_str());

@@ -169,6 +169,11 @@ class RodBlades {
     for (auto& b : blades_) b.advance(system, time, dt);
   }
 
+  /// Every blade's edges (Simulation hides fluid pairs across them).
+  void structure_edges(std::vector<StructureEdge>& edges) const {
+    for (const auto& b : blades_) b.structure_edges(edges);
+  }
+
   std::size_t size() const noexcept { return blades_.size(); }
   const Rod& rod(std::size_t k) const { return blades_.at(k).solid(); }
   /// Rod sub-steps summed over the blades.

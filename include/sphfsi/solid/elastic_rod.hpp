@@ -44,6 +44,7 @@
 #include <sphfsi/core/error.hpp>
 #include <sphfsi/core/particle_set.hpp>
 #include <sphfsi/core/types.hpp>
+#include <sphfsi/fluid/thin_structure_visibility.hpp>
 #include <sphfsi/solid/body.hpp>
 #include <sphfsi/solid/elastic_material.hpp>
 
@@ -329,6 +330,10 @@ class ElasticRod {
   std::int32_t body() const noexcept { return body_; }
   /// Node ids, base to tip.
   const std::vector<std::uint32_t>& particle_ids() const noexcept { return ids_; }
+  /// The rod's edges, base to tip, as pairs of node ids (a thin structure: the fluid does not interact across them).
+  void structure_edges(std::vector<StructureEdge>& edges) const {
+    for (std::size_t j = 0; j + 1 < ids_.size(); ++j) edges.push_back({ids_[j], ids_[j + 1]});
+  }
   /// Mean rest edge length ds, m.
   T reference_spacing() const {
     T sum = T(0);
