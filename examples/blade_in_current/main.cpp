@@ -58,6 +58,7 @@ struct Options {
   T nominal_drag = 2.0;          // C_D used to choose E for a target Ca (the measured one is reported)
   T tow_lengths = 8;             // towing distance after the ramp, in blade lengths
   bool velocity_factor = false;  // eps(u_perp) of eq. 23: off, it rectifies the jitter of a light blade
+  bool visibility = true;        // fluid pairs across the blade do not interact (fluid/thin_structure_visibility.hpp)
   T depth_lengths = 3;           // channel depth in blade lengths (blockage l / depth)
   T average_from = 3;            // the drag is averaged once the blade has moved this many lengths after the ramp
   std::vector<T> cauchy{0, 1, 3, 10, 30, 100, 300, 1000};  // 0: the rigid blade
@@ -115,6 +116,7 @@ CaseResult run_case(const Options& o, T target_ca) {
   FluidParameters<2, T> fluid;
   fluid.gravity = V::Zero();
   fluid.artificial_viscosity = T(0.02);
+  fluid.thin_structure_visibility = o.visibility;
   RepulsiveForce<T> coupling;  // eq. 19 with k = 0.01: no hydrostatic load to balance here
   coupling.velocity_factor = o.velocity_factor;
   Solver sim(system, fluid, {}, Blade(coupling, std::move(rod)));
@@ -176,6 +178,11 @@ int main(int argc, char** argv) try {
   o.tow_lengths = cli.get_number("tow-lengths", o.tow_lengths, "towing distance after the ramp, blade lengths");
   o.velocity_factor =
       cli.get("velocity-factor", "off", "eps(u_perp) of eq. 23 in the blade coupling: on | off") == "on";
+  const std::string visibility =
+      cli.get("visibility", "on", "on: fluid pairs across the blade do not interact (visibility criterion) | off");
+  if (visibility != "on" && visibility != "off")
+    throw InputError(fmt::format("--visibility '{}': valid are on, off", visibility));
+  o.visibility = visibility == "on";
   o.depth_lengths = cli.get_number("depth", o.depth_lengths, "channel depth in blade lengths (blockage 1 / depth)");
   o.average_from = cli.get_number("average-from", o.average_from, "start of the drag average, blade lengths");
   const std::string list = cli.get("cauchy", "0,1,3,10,30,100,300,1000", "target Cauchy numbers (0: rigid blade)");

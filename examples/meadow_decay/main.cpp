@@ -67,6 +67,10 @@ struct Options {
   T added_mass = 1, node_spacing = 1;       // rods: m_a / (rho_w dp), ds / dp
   int load_smoothing = 2, blade_count = 0;  // 0: the meadow's length / dx_b
   bool run_meadow = true, run_empty = true, check = false;
+  // Fluid pairs across a blade interact (false: the 2D full-width blades every 3 dp would otherwise be a dam that
+  // holds the whole wave pressure difference; see docs/meadow.md), and the weak repulsion that stops the fluid.
+  bool visibility = false;
+  std::string repulsion = "stop";  // blade repulsion strength: stop | hydrostatic
   std::filesystem::path out = "out/meadow_decay", empty_from, meadow_from;
 };
 
@@ -137,7 +141,8 @@ RunResult run_case(const Options& o, const std::filesystem::path& dir) {
   const T dp = g.dp();
   System system(scenes::wave_flume_domain(g), Tait<T>(1000, g.sound_speed()));
   const auto layout = scenes::build_wave_flume(system, g);
-  const auto fluid = scenes::wave_flume_fluid(g);
+  auto fluid = scenes::wave_flume_fluid(g);
+  fluid.thin_structure_visibility = o.visibility;
   const auto bases = blade_positions(o);
   const waves::Wavemaker<T> maker(g.wave);
   const auto wave = maker.wave();
@@ -146,7 +151,13 @@ RunResult run_case(const Options& o, const std::filesystem::path& dir) {
       scenes::RodBladeCoupling<T> how;
       how.added_mass_ratio = o.added_mass;
       how.load_smoothing_passes = o.load_smoothing;
-      how.stopping_speed = T(3) * wave.surface_orbital_velocity(g.wave.wave_height);
+      if (o.repulsion == "stop") {
+        how.stopping_speed = T(3) * wave.surface_orbital_velocity(g.wave.wave_height);
+      } else {  // each face holds its own side's hydrostatic load, like a repulsive wall (depth factor of eq. 22)
+        how.coupling.strength = repulsive_strength_for_rest_gap(o.depth, T(9.81), g.sound_speed(), g.smoothing_ratio);
+        how.coupling.water_level = layout.still_level;
+        how.coupling.local_depth = o.depth;
+      }
       return Solver(system, fluid, {}, g.damping_zone(),
                     scenes::add_rod_blades(system, bases, T(0), blade(o), dp, g.smoothing_ratio * dp,
                                            layout.first_free_body, how));
@@ -280,6 +291,13 @@ int main(int argc, char** argv) try {
   o.load_smoothing = int(cli.get_number("load-smoothing", 2, "passes of the load filter along each blade"));
   o.flexural_rigidity = cli.get_number("rigidity", 7.5e-8, "flexural rigidity EI of one blade, N m^2");
   const std::string runs = cli.get("runs", "both", "runs: both | meadow | empty");
+  const std::string visibility =
+      cli.get("visibility", "off",
+              "on: fluid pairs across a blade do not interact (visibility criterion; a 2D blade is then a full-width "
+              "wall) | off: they do, the blade acts on the fluid by its repulsion only");
+  o.repulsion = cli.get("repulsion", "stop",
+                        "blade repulsion strength: stop (weakest that stops the fluid at 3 x the orbital velocity) | "
+                        "hydrostatic (each face holds its side's hydrostatic load: for --visibility on)");
   o.check = cli.get("check", "off",
                     "on: exit status 4 if a fluid particle crossed a blade or a blade tip fell below half its "
                     "length (regression guard)") == "on";
@@ -293,6 +311,11 @@ int main(int argc, char** argv) try {
   require_in_range("--gauge-spacing (m)", o.gauge_spacing, T(0.02), T(2));
   if (runs != "both" && runs != "meadow" && runs != "empty")
     throw InputError(fmt::format("--runs '{}': valid are both, meadow, empty", runs));
+  if (visibility != "on" && visibility != "off")
+    throw InputError(fmt::format("--visibility '{}': valid are on, off", visibility));
+  o.visibility = visibility == "on";
+  if (o.repulsion != "hydrostatic" && o.repulsion != "stop")
+    throw InputError(fmt::format("--repulsion '{}': valid are hydrostatic, stop", o.repulsion));
   o.run_meadow = runs != "empty" && o.meadow_from.empty();
   o.run_empty = runs != "meadow" && o.empty_from.empty();
 

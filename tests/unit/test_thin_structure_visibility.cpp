@@ -50,7 +50,7 @@ TEST_CASE("segments_cross: proper crossings only", "[visibility]") {
   CHECK(int(Visibility::segments_cross(V(1, -1), V(1, 1), a, node)) +
             int(Visibility::segments_cross(V(1, -1), V(1, 1), node, straight)) ==
         1);
-  CHECK_FALSE(Visibility::segments_cross(V(0, 0.2), V(1, 0.2), a, b));    // parallel
+  CHECK_FALSE(Visibility::segments_cross(V(0, 0.2), V(1, 0.2), a, b));  // parallel
 }
 
 TEST_CASE("thin-structure visibility hides exactly the pairs that cross a bent blade", "[visibility]") {
@@ -125,14 +125,13 @@ TEST_CASE("thin-structure visibility: the fluid beside a held blade does not fee
     sim.evaluate_rates(0.0);
     V force = V::Zero();
     for (std::size_t i = 0; i < p.size(); ++i)
-      if (p.kind[i] == Kind::fluid && p.position[i][0] < 0.0525)
-        force += p.mass[i] * (p.acceleration[i] - V(0, -9.81));
+      if (p.kind[i] == Kind::fluid && p.position[i][0] < 0.0525) force += p.mass[i] * (p.acceleration[i] - V(0, -9.81));
     return std::pair{force, sim.fluid().structure_visibility().edges().size()};
   };
   const auto [open, edges_unused] = left_force(false);
   const auto [hidden, edges] = left_force(true);
-  INFO("left water's fluid force: without the criterion " << open.transpose() << " N/m, with it "
-                                                          << hidden.transpose() << " N/m");
+  INFO("left water's fluid force: without the criterion " << open.transpose() << " N/m, with it " << hidden.transpose()
+                                                          << " N/m");
   CHECK(edges == 24);  // the rod published its edges to the fluid (whether or not they are applied)
   CHECK(edges_unused == 24);
   // Through the blade the right block pulls the left water up (viscosity) and pushes it left (pressure); with the

@@ -55,9 +55,7 @@ class CoupledBody {
   /// The solid's thin-structure edges, if it has any (Simulation hides fluid pairs across them).
   template <class Edges>
     requires requires(const Solid& s, Edges& e) { s.structure_edges(e); }
-  void structure_edges(Edges& edges) const {
-    solid_.structure_edges(edges);
-  }
+  void structure_edges(Edges& edges) const { solid_.structure_edges(edges); }
 
   Solid& solid() noexcept { return solid_; }
   const Solid& solid() const noexcept { return solid_; }

@@ -10,8 +10,9 @@
 // 139:3). A pair (a, b) is blocked when x_a and x_b lie strictly on opposite sides of an edge x_i x_j's line and
 // the edge's end points on opposite sides of the pair's line, half-open: an edge's first end point on that line
 // counts as below it, its second as above. So a pair whose segment passes exactly through a node between two edges
-// (a lattice line through the nodes) is hidden by exactly one of them, and a particle exactly on an edge is not. The structure's coupling policy then has
-// to carry the whole load of each face (a blade holds the pressure of both sides, not only their difference).
+// (a lattice line through the nodes) is hidden by exactly one of them, and a particle exactly on an edge is not. The
+// structure's coupling policy then has to carry the whole load of each face (a blade holds the pressure of both sides,
+// not only their difference).
 //
 // Candidate edges of a particle: the edges adjacent to the structure's nodes that have the particle within their
 // kernel support (the system's own neighbour lists). For a blocked pair with crossing point c,
@@ -57,9 +58,10 @@ class ThinStructureVisibility {
     for (std::size_t k = 0; k < edges_.size(); ++k) {
       for (int end = 0; end < 2; ++end) {
         if (!p.contains_id(edges_[k][end]))
-          throw InputError(fmt::format("ThinStructureVisibility: edge {} names particle id {}, which is not in the "
-                                       "system (valid: ids of the structure's nodes)",
-                                       k, edges_[k][end]));
+          throw InputError(
+              fmt::format("ThinStructureVisibility: edge {} names particle id {}, which is not in the "
+                          "system (valid: ids of the structure's nodes)",
+                          k, edges_[k][end]));
       }
       const std::size_t s0 = p.slot_of_id(edges_[k][0]), s1 = p.slot_of_id(edges_[k][1]);
       from_[k] = p.position[s0];

@@ -92,7 +92,7 @@ struct FluidParameters {
   T minimum_pressure{-std::numeric_limits<T>::infinity()};
   /// Pairs whose segment crosses an edge of a thin structure (WcsphFluid::set_structure_edges) do not interact
   /// (true); false: the published edges are ignored and the fluid interacts through the structure in its sums.
-  bool thin_structure_visibility{true};
+  bool thin_structure_visibility{false};
 
   void validate() const {
     for (int d = 0; d < Dim; ++d) require_finite("FluidParameters::gravity", gravity[d]);
@@ -393,7 +393,7 @@ class WcsphFluid {
       const Kind kb = kind[b];
       const bool fluid_b = kb == Kind::fluid;
       if (kb == Kind::solid || !(fluid_a || fluid_b)) return;  // wall-wall pairs do not interact
-      if constexpr (Dim == 2) {  // hidden from each other by a thin structure
+      if constexpr (Dim == 2) {                                // hidden from each other by a thin structure
         if (occluded_ && (visibility_.near(a) || visibility_.near(b)) && visibility_.blocks(a, b, xa, x[b])) return;
       }
       const Vector vab = va - v[b];
@@ -466,11 +466,11 @@ class WcsphFluid {
 
   FluidParameters<Dim, T> params_;
   std::vector<T> signal_speed_;
-  std::vector<T> pressure_term_;          // p / rho^2 per slot, Pa m^6/kg^2
-  std::vector<T> volume_;                 // m / rho per slot
-  std::vector<Spill> spills_;             // one per slot range
-  std::vector<Mat<Dim, T>> correction_;   // L_a per slot (valid where corrected_[a])
-  std::vector<unsigned char> corrected_;  // 1: slot a uses the corrected pressure gradient
+  std::vector<T> pressure_term_;           // p / rho^2 per slot, Pa m^6/kg^2
+  std::vector<T> volume_;                  // m / rho per slot
+  std::vector<Spill> spills_;              // one per slot range
+  std::vector<Mat<Dim, T>> correction_;    // L_a per slot (valid where corrected_[a])
+  std::vector<unsigned char> corrected_;   // 1: slot a uses the corrected pressure gradient
   ThinStructureVisibility<T> visibility_;  // edges of thin structures (2D)
   bool occluded_{false};                   // this evaluation applies the visibility criterion
 };
