@@ -2,6 +2,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 
 namespace sphfsi {
@@ -45,5 +46,9 @@ concept Real = std::is_same_v<T, float> || std::is_same_v<T, double>;
 
 template <int Dim>
 concept SpatialDimension = (Dim == 2 || Dim == 3);
+
+/// An edge of a thin structure (a blade as one line of nodes): the ids of its two end nodes. Solids publish their
+/// edges, the fluid hides particle pairs across them (fluid/thin_structure_visibility.hpp).
+using StructureEdge = std::array<std::uint32_t, 2>;
 
 }  // namespace sphfsi

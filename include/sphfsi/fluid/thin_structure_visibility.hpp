@@ -25,14 +25,10 @@
 #include <sphfsi/core/error.hpp>
 #include <sphfsi/core/types.hpp>
 
-#include <array>
 #include <cstdint>
 #include <vector>
 
 namespace sphfsi {
-
-/// An edge of a thin structure: the ids of its two end nodes.
-using StructureEdge = std::array<std::uint32_t, 2>;
 
 /// Which pairs of particles a set of thin-structure edges hides from each other (see the header comment).
 template <Real T>

@@ -261,15 +261,12 @@ class Simulation {
   void collect_structure_edges() {
     edges_collected_ = true;
     std::vector<StructureEdge> edges;
-    std::apply(
-        [&](const auto&... m) {
-          const auto append = [&](const auto& model) {
-            if constexpr (requires { model.structure_edges(edges); }) model.structure_edges(edges);
-          };
-          (append(m), ...);
-        },
-        models_);
+    std::apply([&](const auto&... m) { (append_structure_edges(m, edges), ...); }, models_);
     if (!edges.empty()) fluid_.set_structure_edges(std::move(edges));
+  }
+  template <class Model>
+  static void append_structure_edges(const Model& model, std::vector<StructureEdge>& edges) {
+    if constexpr (requires { model.structure_edges(edges); }) model.structure_edges(edges);
   }
 
   void record_reference_positions() {

@@ -44,7 +44,6 @@
 #include <sphfsi/core/error.hpp>
 #include <sphfsi/core/particle_set.hpp>
 #include <sphfsi/core/types.hpp>
-#include <sphfsi/fluid/thin_structure_visibility.hpp>
 #include <sphfsi/solid/body.hpp>
 #include <sphfsi/solid/elastic_material.hpp>
 
