@@ -193,6 +193,8 @@ int main(int argc, char** argv) try {
       cli.get_number("solid-refinement", 1, "gate particle spacing dp / this: 1, 2 or 4 (finer solid than fluid)"));
   opt.scene.fluid_sound_speed = cli.get_number("fluid-sound-speed", 20, "fluid reference sound speed c0, m/s");
   opt.scene.youngs_modulus = cli.get_number("youngs-modulus", 1.2e7, "gate Young's modulus E, Pa");
+  const std::string plane = cli.get(
+      "plane", "strain", "2D gate: strain (plane strain, a wide plate) | stress (plane stress, free to contract)");
   opt.end_time = cli.get_number("end-time", 0.4, "simulated time, s");
   opt.snapshot_interval = cli.get_number("snapshot-interval", 0.02, "time between VTK snapshots, s");
   opt.output = cli.get("output", "out/antoci_gate", "output folder");
@@ -211,6 +213,9 @@ int main(int argc, char** argv) try {
   if (solid != "tl" && solid != "ul" && solid != "ul-gms")
     throw InputError(fmt::format("--solid = '{}' is invalid: valid values are tl, ul, ul-gms", solid));
   opt.gray_monaghan_swift = solid == "ul-gms";
+  if (plane != "strain" && plane != "stress")
+    throw InputError(fmt::format("--plane = '{}' is invalid: valid values are strain, stress", plane));
+  opt.scene.plane_stress = plane == "stress";
   // eps(z) of eq. 22 scales the repulsion with the depth below the still-water level, like hydrostatic pressure.
   RepulsiveForce<Scalar> repulsive;
   repulsive.water_level = opt.scene.column_height;

@@ -13,10 +13,11 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
-#include <set>
 #include <utility>
+#include <vector>
 
 using namespace sphfsi;
 

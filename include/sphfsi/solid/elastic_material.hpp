@@ -7,7 +7,11 @@
 //   bulk sound speed   c0     = sqrt(K / rho)          (Gray, Monaghan & Swift 2001, CMAME 190:6641, eq. 2.10)
 //   P-wave speed       c_p    = sqrt((K + 4 G / 3) / rho)  (fastest signal: the solid's CFL condition)
 //   plane-strain modulus E'   = E / (1 - nu^2)         (2D bending stiffness of a plate in plane strain)
-// Two-dimensional solids are in plane strain: the 3D constants above are used unchanged.
+// Two-dimensional solids are in plane strain: the 3D constants above are used unchanged. A 2D body in plane stress
+// (a plate narrow across the third direction, free to contract in it) has the in-plane law
+// sigma = lambda' tr(eps) I + 2 G eps with lambda' = 2 lambda G / (lambda + 2 G) = E nu / (1 - nu^2); the plane-strain
+// solids reproduce it exactly with the material plane_stress_equivalent(): nu* = nu / (1 + nu),
+// E* = E (1 + 2 nu) / (1 + nu)^2 (same G, lambda* = lambda'; e.g. Timoshenko & Goodier, Theory of Elasticity, sec. 16).
 #pragma once
 
 #include <sphfsi/core/error.hpp>
@@ -43,6 +47,11 @@ struct ElasticMaterial {
   }
   T plane_strain_modulus() const {  ///< E', Pa
     return youngs_modulus / (T(1) - poisson_ratio * poisson_ratio);
+  }
+  /// The material whose plane-strain (2D) constants are this material's plane-stress ones (see the header comment).
+  ElasticMaterial plane_stress_equivalent() const {
+    const T nu = poisson_ratio;
+    return {density, youngs_modulus * (T(1) + T(2) * nu) / ((T(1) + nu) * (T(1) + nu)), nu / (T(1) + nu)};
   }
 };
 
