@@ -282,6 +282,14 @@ TEST_CASE("ElasticMaterial: derived moduli and input validation", "[solid]") {
   // K = lambda + 2 G / 3 and c0^2 = K / rho (Gray et al. 2001) are the same constants written two ways.
   CHECK(m.lame_lambda() + 2.0 / 3.0 * m.shear_modulus() == Approx(m.bulk_modulus()).epsilon(1e-12));
   CHECK(m.sound_speed() == Approx(std::sqrt(m.bulk_modulus() / 1000)).epsilon(1e-14));
+  // Plane stress through the plane-strain solids: same G, lambda* = E nu / (1 - nu^2), and the 2D plate modulus
+  // (E* / (1 - nu*^2) of the equivalent material) is E itself.
+  const auto ps = m.plane_stress_equivalent();
+  const double nu = m.poisson_ratio, E = m.youngs_modulus;
+  CHECK(ps.shear_modulus() == Approx(m.shear_modulus()).epsilon(1e-14));
+  CHECK(ps.lame_lambda() == Approx(E * nu / (1 - nu * nu)).epsilon(1e-13));
+  CHECK(ps.plane_strain_modulus() == Approx(E).epsilon(1e-13));
+  CHECK(ps.density == m.density);
   auto bad = m;
   bad.youngs_modulus = 0;
   CHECK_THROWS_AS(bad.validate(), sphfsi::InputError);
