@@ -98,6 +98,9 @@ TEST_CASE("thin-structure visibility hides exactly the pairs that cross a bent b
   INFO(pairs << " pairs, " << hidden << " hidden by the blade");
   CHECK(hidden > 500);  // the blade cuts the block: many pairs cross it
   CHECK(mismatches == 0);
+  // An edge too long for the candidate search (its nodes' supports would not cover every crossing) is an error.
+  p.position[p.slot_of_id(node_ids[20])] += V(0.05, 0);
+  CHECK_THROWS_WITH(visibility.update(system), Catch::Contains("edge 19") && Catch::Contains("valid range"));
 }
 
 TEST_CASE("thin-structure visibility: the fluid beside a held blade does not feel the other face", "[visibility]") {

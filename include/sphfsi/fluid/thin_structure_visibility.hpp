@@ -24,7 +24,10 @@
 
 #include <sphfsi/core/error.hpp>
 #include <sphfsi/core/types.hpp>
+#include <sphfsi/kernel/concepts.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -62,6 +65,14 @@ class ThinStructureVisibility {
       const std::size_t s0 = p.slot_of_id(edges_[k][0]), s1 = p.slot_of_id(edges_[k][1]);
       from_[k] = p.position[s0];
       to_[k] = p.position[s1];
+      // The candidate search finds every hidden pair only for edges up to sqrt(3) x the nodes' support radius.
+      const T reach =
+          support_radius<typename System::kernel_type>(std::min(p.smoothing_length[s0], p.smoothing_length[s1]));
+      if (!((to_[k] - from_[k]).norm() <= std::sqrt(T(3)) * reach))
+        throw InputError(
+            fmt::format("ThinStructureVisibility: edge {} is {:.4g} m long: valid range is up to "
+                        "sqrt(3) x the nodes' support radius, {:.4g} m (refine the structure's nodes)",
+                        k, double((to_[k] - from_[k]).norm()), double(std::sqrt(T(3)) * reach)));
       for (const std::size_t s : {s0, s1}) {
         system.for_each_neighbor(s, [&](std::size_t f, const Vector&, T, T) {
           if (p.kind[f] == Kind::solid) return;
