@@ -51,6 +51,8 @@ struct Options {
   double end_time{0};
   double snapshots{0};
   bool run_plants{true}, run_empty{true};
+  bool visibility{
+      false};  // rod blades: fluid pairs across a blade do not interact (fluid/thin_structure_visibility.hpp)
   std::filesystem::path out;
   std::filesystem::path empty_from;  // reuse DIR/empty/wave_heights.csv of an earlier run instead of the empty run
 };
@@ -103,6 +105,7 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
   FluidParameters<2, T> fluid = scenes::wave_flume_fluid(g);
   fluid.artificial_viscosity = T(o.alpha);
   fluid.density_diffusion = T(o.delta);
+  fluid.thin_structure_visibility = o.visibility;
 
   auto make_solver = [&]() {
     if constexpr (Rods) {
@@ -413,6 +416,13 @@ int main(int argc, char** argv) try {
   s.real_youngs_modulus = cli.get_number("real-modulus", 4.7e8, "Young's modulus of the real blade, Pa");
   s.real_thickness = cli.get_number("real-thickness", 1e-4, "thickness of the real blade, m");
   const std::string runs = cli.get("runs", "both", "runs: both | plants | empty");
+  const std::string visibility =
+      cli.get("visibility", "off",
+              "rod blade: on: fluid pairs across the blade do not interact (the blade then holds each face's whole "
+              "pressure: raise --repulsion) | off");
+  if (visibility != "on" && visibility != "off")
+    throw InputError(fmt::format("--visibility '{}': valid are on, off", visibility));
+  o.visibility = visibility == "on";
   o.alpha = cli.get_number("alpha", 0.01, "artificial viscosity alpha");
   o.delta = cli.get_number("delta", 0.1, "delta-SPH coefficient");
   o.waves_analysed = cli.get_number("waves", 4, "full-amplitude waves recorded at the last gauge");
