@@ -187,16 +187,12 @@ int main(int argc, char** argv) try {
   o.thickness = cli.get_number("thickness", o.thickness, "blade thickness t, m");
   o.particles_along = cli.get_number("resolution", o.particles_along, "fluid particles along the blade, l / dp");
   o.tow_lengths = cli.get_number("tow-lengths", o.tow_lengths, "towing distance after the ramp, blade lengths");
-  o.velocity_factor =
-      cli.get("velocity-factor", "off", "eps(u_perp) of eq. 23 in the blade coupling: on | off") == "on";
-  const std::string visibility =
-      cli.get("visibility", "on", "on: fluid pairs across the blade do not interact (visibility criterion) | off");
-  if (visibility != "on" && visibility != "off")
-    throw InputError(fmt::format("--visibility '{}': valid are on, off", visibility));
-  o.visibility = visibility == "on";
-  o.global_step = cli.get("global-step", "off",
-                          "on: the fluid steps with the rod's stable step (no sub-cycling; for the cost comparison) | "
-                          "off") == "on";
+  o.velocity_factor = cli.get_switch("velocity-factor", false, "eps(u_perp) of eq. 23 in the blade coupling: on | off");
+  o.visibility = cli.get_switch("visibility", true,
+                                "on: fluid pairs across the blade do not interact (visibility criterion) | off");
+  o.global_step =
+      cli.get_switch("global-step", false,
+                     "on: the fluid steps with the rod's stable step (no sub-cycling; for the cost comparison) | off");
   o.end_time = cli.get_number("end-time", 0, "simulated time, s (0: the ramp and the whole towing distance)");
   require_non_negative("--end-time (s)", o.end_time);
   o.depth_lengths = cli.get_number("depth", o.depth_lengths, "channel depth in blade lengths (blockage 1 / depth)");

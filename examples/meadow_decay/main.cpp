@@ -291,16 +291,16 @@ int main(int argc, char** argv) try {
   o.load_smoothing = int(cli.get_number("load-smoothing", 2, "passes of the load filter along each blade"));
   o.flexural_rigidity = cli.get_number("rigidity", 7.5e-8, "flexural rigidity EI of one blade, N m^2");
   const std::string runs = cli.get("runs", "both", "runs: both | meadow | empty");
-  const std::string visibility =
-      cli.get("visibility", "off",
-              "on: fluid pairs across a blade do not interact (visibility criterion; a 2D blade is then a full-width "
-              "wall) | off: they do, the blade acts on the fluid by its repulsion only");
+  o.visibility =
+      cli.get_switch("visibility", false,
+                     "on: fluid pairs across a blade do not interact (visibility criterion; a 2D blade is "
+                     "then a full-width wall) | off: they do, the blade acts on the fluid by its repulsion only");
   o.repulsion = cli.get("repulsion", "stop",
                         "blade repulsion strength: stop (weakest that stops the fluid at 3 x the orbital velocity) | "
                         "hydrostatic (each face holds its side's hydrostatic load: for --visibility on)");
-  o.check = cli.get("check", "off",
-                    "on: exit status 4 if a fluid particle crossed a blade or a blade tip fell below half its "
-                    "length (regression guard)") == "on";
+  o.check = cli.get_switch("check", false,
+                           "on: exit status 4 if a fluid particle crossed a blade or a blade tip fell below half its "
+                           "length (regression guard)");
   o.out = cli.get("output", "out/meadow_decay", "output folder");
   o.empty_from = cli.get("empty-from", "", "with --runs meadow: take the empty flume's heights from DIR/empty");
   o.meadow_from = cli.get("meadow-from", "", "analyse DIR/meadow/wave_heights.csv of an earlier run (no meadow run)");
@@ -311,9 +311,6 @@ int main(int argc, char** argv) try {
   require_in_range("--gauge-spacing (m)", o.gauge_spacing, T(0.02), T(2));
   if (runs != "both" && runs != "meadow" && runs != "empty")
     throw InputError(fmt::format("--runs '{}': valid are both, meadow, empty", runs));
-  if (visibility != "on" && visibility != "off")
-    throw InputError(fmt::format("--visibility '{}': valid are on, off", visibility));
-  o.visibility = visibility == "on";
   if (o.repulsion != "hydrostatic" && o.repulsion != "stop")
     throw InputError(fmt::format("--repulsion '{}': valid are hydrostatic, stop", o.repulsion));
   o.run_meadow = runs != "empty" && o.meadow_from.empty();

@@ -51,8 +51,8 @@ struct Options {
   double end_time{0};
   double snapshots{0};
   bool run_plants{true}, run_empty{true};
-  bool visibility{
-      false};  // rod blades: fluid pairs across a blade do not interact (fluid/thin_structure_visibility.hpp)
+  // Rod blades: fluid pairs across a blade do not interact (fluid/thin_structure_visibility.hpp).
+  bool visibility{false};
   std::filesystem::path out;
   std::filesystem::path empty_from;  // reuse DIR/empty/wave_heights.csv of an earlier run instead of the empty run
 };
@@ -408,7 +408,7 @@ int main(int argc, char** argv) try {
   s.rod_node_spacing = cli.get_number("rod-spacing", 0.5, "rod blade: node spacing / dp");
   s.rod_added_mass = cli.get_number("added-mass", 1, "rod blade: added inertia per length and width / (rho_w dp)");
   s.rod_load_smoothing = int(cli.get_number("load-smoothing", 2, "rod blade: passes of the load filter"));
-  s.rod_velocity_factor = cli.get("velocity-factor", "off", "rod blade: eq. 23 velocity factor on | off") == "on";
+  s.rod_velocity_factor = cli.get_switch("velocity-factor", false, "rod blade: eq. 23 velocity factor on | off");
   s.rod_repulsion =
       cli.get_number("repulsion", 0, "rod blade: k of eq. 19, A = k c0^2 / h (0: stops 3 x the orbital velocity)");
   s.poisson_ratio = cli.get_number("poisson", 0.3, "Poisson ratio of the real and scaled blade");
@@ -416,13 +416,9 @@ int main(int argc, char** argv) try {
   s.real_youngs_modulus = cli.get_number("real-modulus", 4.7e8, "Young's modulus of the real blade, Pa");
   s.real_thickness = cli.get_number("real-thickness", 1e-4, "thickness of the real blade, m");
   const std::string runs = cli.get("runs", "both", "runs: both | plants | empty");
-  const std::string visibility =
-      cli.get("visibility", "off",
-              "rod blade: on: fluid pairs across the blade do not interact (the blade then holds each face's whole "
-              "pressure: raise --repulsion) | off");
-  if (visibility != "on" && visibility != "off")
-    throw InputError(fmt::format("--visibility '{}': valid are on, off", visibility));
-  o.visibility = visibility == "on";
+  o.visibility = cli.get_switch("visibility", false,
+                                "rod blade: on: fluid pairs across the blade do not interact (the blade then holds "
+                                "each face's whole pressure: raise --repulsion) | off");
   o.alpha = cli.get_number("alpha", 0.01, "artificial viscosity alpha");
   o.delta = cli.get_number("delta", 0.1, "delta-SPH coefficient");
   o.waves_analysed = cli.get_number("waves", 4, "full-amplitude waves recorded at the last gauge");

@@ -1,5 +1,6 @@
 // Tests of sphfsi/io: VTK XML snapshots and series (decoded back here byte by byte), CSV writer and reader.
 // An independent check with VTK's own reader is tests/python/check_vtk.py.
+#include <sphfsi/io/command_line.hpp>
 #include <sphfsi/io/csv.hpp>
 #include <sphfsi/io/vtk_writer.hpp>
 
@@ -342,4 +343,16 @@ TEST_CASE("read_csv reads the shipped validation data", "[io][csv]") {
   REQUIRE(t.size() > 5);
   CHECK(t[0] == 0.43012);
   CHECK(z[0] == 1.10782);
+}
+
+TEST_CASE("CommandLine::get_switch: on, off, the default, and a clear error otherwise", "[io]") {
+  std::vector<std::string> words{"prog", "--a", "on", "--b", "off", "--c", "yes"};
+  std::vector<char*> argv;
+  for (auto& w : words) argv.push_back(w.data());
+  sphfsi::io::CommandLine cli(int(argv.size()), argv.data(), "test");
+  CHECK(cli.get_switch("a", false, "a switch"));
+  CHECK_FALSE(cli.get_switch("b", true, "a switch"));
+  CHECK(cli.get_switch("d", true, "absent: the default"));
+  CHECK_THROWS_WITH(cli.get_switch("c", false, "a switch"),
+                    Catch::Contains("--c = 'yes'") && Catch::Contains("valid values are on, off"));
 }

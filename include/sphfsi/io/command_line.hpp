@@ -42,6 +42,14 @@ class CommandLine {
     return v;
   }
 
+  /// An on | off flag: true for "on"; any other value than "on" or "off" is an InputError naming the flag.
+  bool get_switch(std::string_view name, bool default_on, std::string_view help) {
+    const std::string s = get(name, default_on ? "on" : "off", help);
+    if (s != "on" && s != "off")
+      throw InputError(fmt::format("--{} = '{}' is invalid: valid values are on, off", name, s));
+    return s == "on";
+  }
+
   /// Returns false (after printing the help) if --help was given; throws on unknown flags.
   bool finish() {
     for (std::size_t i = 0; i < args_.size(); ++i) {
