@@ -154,10 +154,10 @@ CaseResult run_case(const Options& o, T target_ca) {
     }
   });
   progress.finish(sim);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   // Mean drag and its standard error from 8 blocks (the samples are correlated within a block).
   const std::size_t blocks = 8, per = samples.size() / blocks;
   if (per == 0) {  // a run shorter than the averaging window (--end-time): no drag average
-    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const T nan = std::numeric_limits<T>::quiet_NaN();
     return {target_ca, material.youngs_modulus, nan, nan, nan, nan, wall, sim.step_count(), system.size()};
   }
@@ -172,7 +172,6 @@ CaseResult run_case(const Options& o, T target_ca) {
     var += (m - mean) * (m - mean);
   }
   const T se = std::sqrt(var / T(blocks * (blocks - 1)));
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return {target_ca, material.youngs_modulus, mean,         se, tip_x / T(tip_n), tip_y / T(tip_n),
           wall,      sim.step_count(),        system.size()};
 }

@@ -26,8 +26,8 @@ int main(int argc, char** argv) try {
   const double end_time = cli.get_number("end-time", 2.0, "simulated time, s (settling)");
   cfg.smoothing_ratio = cli.get_number("smoothing-ratio", cfg.smoothing_ratio, "smoothing length over spacing h/dp");
   const std::filesystem::path output = cli.get("output", "hydrostatic_tank_output", "output folder");
-  const std::string depth_scaling =
-      cli.get("depth-scaling", "on", "repulsive walls: eps(z) of eq. 22 with h0 = H, z0 = H (on | off)");
+  cfg.depth_scaling =
+      cli.get_switch("depth-scaling", true, "repulsive walls: eps(z) of eq. 22 with h0 = H, z0 = H (on | off)");
   const std::string correction = cli.get("gradient-correction", "near-walls",
                                          "kernel-gradient correction of the pressure gradient (Bonet & Lok 1999): "
                                          "none | near-walls (fluid next to repulsive walls) | everywhere");
@@ -45,10 +45,7 @@ int main(int argc, char** argv) try {
         "--gradient-correction = '{}' is invalid: valid values are none, near-walls, everywhere", correction));
   if (walls != "dynamic" && walls != "repulsive")
     throw InputError(fmt::format("--walls = '{}' is invalid: valid values are dynamic, repulsive", walls));
-  if (depth_scaling != "on" && depth_scaling != "off")
-    throw InputError(fmt::format("--depth-scaling = '{}' is invalid: valid values are on, off", depth_scaling));
   cfg.walls = walls == "dynamic" ? WallModel::dynamic : WallModel::repulsive;
-  cfg.depth_scaling = depth_scaling == "on";
   require_positive("--end-time (s)", end_time);
 
   System system = make_tank(cfg);

@@ -32,22 +32,20 @@ int main(int argc, char** argv) try {
   cfg.wall_columns =
       static_cast<int>(cli.get_number("wall-columns", cfg.wall_columns, "coarse base columns next to each side wall"));
   const double end_time = cli.get_number("end-time", 1.0, "simulated time, s (settling)");
-  const std::string refine = cli.get("refine", "on", "refinement boxes: on | off (the uniform tank)");
+  const bool refine = cli.get_switch("refine", true, "refinement boxes: on | off (the uniform tank)");
   const std::string correction = cli.get("gradient-correction", "jumps",
                                          "pressure gradient: jumps (corrected difference form at resolution jumps) | "
                                          "none (symmetric) | everywhere (Bonet-Lok everywhere)");
   const double alpha = cli.get_number("alpha", 0.1, "artificial viscosity alpha");
   const std::filesystem::path output = cli.get("output", "refined_tank_output", "output folder");
   if (!cli.finish()) return 0;
-  if (refine != "on" && refine != "off")
-    throw InputError(fmt::format("--refine = '{}' is invalid: valid values are on, off", refine));
   require_positive("--end-time (s)", end_time);
   if (correction != "jumps" && correction != "none" && correction != "everywhere")
     throw InputError(
         fmt::format("--gradient-correction = '{}' is invalid: valid values are jumps, none, everywhere", correction));
 
   System system = tank::make_tank(cfg.tank);
-  auto boxes = refine == "on" ? refinement_boxes(cfg) : std::vector<RefinementBox<2, double>>{};
+  auto boxes = refine ? refinement_boxes(cfg) : std::vector<RefinementBox<2, double>>{};
   auto fluid = tank::fluid_parameters(cfg.tank);
   fluid.artificial_viscosity = alpha;
   if (correction == "everywhere") fluid.gradient_correction = GradientCorrection::everywhere;
@@ -57,15 +55,15 @@ int main(int argc, char** argv) try {
   const double mass0 = fluid_mass(system);
   const Vector probe(0.5 * cfg.tank.width, cfg.band_centre());
   fmt::print("refined tank: H = {} m, L = {} m, dp = {:.4g} m, refinement {}, {} fluid + {} wall particles\n",
-             cfg.tank.depth, cfg.tank.width, cfg.tank.dp(), refine, system.particles().count(Kind::fluid),
-             system.particles().count(Kind::wall));
+             cfg.tank.depth, cfg.tank.width, cfg.tank.dp(), refine ? "on" : "off",
+             system.particles().count(Kind::fluid), system.particles().count(Kind::wall));
 
   io::CsvWriter probe_csv(output / "probe.csv",
                           {"t", "relative_error", "kinetic_energy", "max_speed", "mass_change", "level0", "level1",
                            "level2", "splits", "merges"},
                           fmt::format("refined tank ({}), probe at x = {} m, z = {} m; relative_error of the Shepard "
                                       "pressure against rho0 g (H_s - z); mass_change relative to t = 0",
-                                      refine, probe[0], probe[1]));
+                                      refine ? "on" : "off", probe[0], probe[1]));
   double next_sample = 0;
   auto sample = [&](RefinedSimulation& s) {
     if (s.time() < next_sample - 1e-12) return;

@@ -74,7 +74,7 @@ int main(int argc, char** argv) try {
   const double upstream = cli.get_number("upstream-gauge", 0.75, "upstream gauge, wavelengths from the paddle");
   const double downstream = cli.get_number("downstream-gauge", 2.25, "downstream gauge, wavelengths");
   const double alpha = cli.get_number("alpha", 0.01, "artificial viscosity alpha (both runs)");
-  const std::string refine = cli.get("refine", "on", "refinement box: on | off (the uniform flume)");
+  const bool refine = cli.get_switch("refine", true, "refinement box: on | off (the uniform flume)");
   const std::string compare = cli.get("compare", "", "output folder of the --refine off run to compare with");
   const double settle = cli.get_number("settle", 4, "periods after the linear arrival before a gauge is analysed");
   const double waves_analysed = cli.get_number("waves", 3, "full waves analysed at the downstream gauge");
@@ -82,14 +82,12 @@ int main(int argc, char** argv) try {
   const double bed_rows = cli.get_number("bed-rows", 2, "base rows kept coarse above the bed");
   const double top_rows = cli.get_number(
       "top-rows", 0, "base rows kept coarse below the still surface (0: the box reaches above the crests)");
-  const std::string wall_viscosity =
-      cli.get("wall-viscosity", "off", "artificial viscosity with wall particles: on | off");
-  const std::string fine_bed =
-      cli.get("fine-bed", "off", "bed under the box built at the fine spacing: on | off (then use --bed-rows 0)");
+  const bool wall_viscosity =
+      cli.get_switch("wall-viscosity", false, "artificial viscosity with wall particles: on | off");
+  const bool fine_bed = cli.get_switch("fine-bed", false,
+                                       "bed under the box built at the fine spacing: on | off (then use --bed-rows 0)");
   const double end_override = cli.get_number("end-time", 0, "end time, s (0: from the waves to analyse)");
   if (!cli.finish()) return 0;
-  if (refine != "on" && refine != "off")
-    throw InputError(fmt::format("--refine = '{}' is invalid: valid values are on, off", refine));
 
   System system(scenes::wave_flume_domain(g), Tait<T>(1000, g.sound_speed()));
   const auto layout = scenes::build_wave_flume(system, g);
@@ -97,7 +95,7 @@ int main(int argc, char** argv) try {
   const double L = g.wavelength(), dp = g.dp();
   // The box's ends lie on base-lattice cell edges, so the daughters tile their parents' cells.
   const double x0 = std::round(box_from * L / dp) * dp, x1 = std::round((box_from + box_length) * L / dp) * dp;
-  if (fine_bed == "on" && refine == "on") {
+  if (fine_bed && refine) {
     // The bed under the box at the fine spacing (same thickness): no fine fluid particle sees a coarse wall.
     auto& p = system.particles();
     for (std::size_t i = p.size(); i-- > 0;)
@@ -111,14 +109,14 @@ int main(int argc, char** argv) try {
     set_hydrostatic_wall_density(system, g.depth(), g.wave.gravity);
   }
   fluid.artificial_viscosity = alpha;
-  fluid.wall_artificial_viscosity = wall_viscosity == "on";          // off: the flume's default (docs/flume.md)
+  fluid.wall_artificial_viscosity = wall_viscosity;                  // off: the flume's default (docs/flume.md)
   fluid.gradient_correction = GradientCorrection::resolution_jumps;  // inert without resolution jumps
   std::vector<RefinementBox<2, T>> boxes;
   // From two base rows above the bed to above the crests: the bed is built at the base spacing, and fine particles
   // against a coarse dynamic wall are sucked onto it (measured: a blow-up within 0.1 s with the box down to the bed).
   // top_rows > 0: the box ends top_rows base rows below the still surface (a submerged zone); 0: above the crests.
   const double z1 = top_rows > 0 ? g.depth() - top_rows * dp : g.wall_height();
-  if (refine == "on") boxes.push_back({V2(x0, bed_rows * dp), V2(x1, z1), 1});
+  if (refine) boxes.push_back({V2(x0, bed_rows * dp), V2(x1, z1), 1});
   RefinementParameters<T> params;
   params.base_spacing = dp;
   params.buffer_width = buffer_dp * dp;
@@ -136,15 +134,16 @@ int main(int argc, char** argv) try {
   const double end_time =
       end_override > 0 ? end_override : maker.ramp_time() + gauge_x[1] / c_g + (settle + waves_analysed + 0.5) * period;
   fmt::print(
-      "refined wave ({}): dp = {:.4f} m (h/dp = {:.0f}, H/dp = {:.2f}), L = {:.3f} m, box [{:.3f}, {:.3f}] m "
+      "refined wave (refine {}): dp = {:.4f} m (h/dp = {:.0f}, H/dp = {:.2f}), L = {:.3f} m, box [{:.3f}, {:.3f}] m "
       "(level 1, buffer {:.3f} m), gauges at {:.3f} and {:.3f} m, {} fluid + {} wall particles, alpha = {}, end "
       "{:.2f} s\n",
-      refine, dp, g.particles_per_depth, g.wave.wave_height / dp, L, x0, x1, params.buffer_width, gauge_x[0],
-      gauge_x[1], layout.fluid_particles, system.size() - layout.fluid_particles, alpha, end_time);
+      refine ? "on" : "off", dp, g.particles_per_depth, g.wave.wave_height / dp, L, x0, x1, params.buffer_width,
+      gauge_x[0], gauge_x[1], layout.fluid_particles, system.size() - layout.fluid_particles, alpha, end_time);
 
   std::filesystem::create_directories(out);
   waves::WaveGauges<T> gauges(gauge_x, layout.still_level, dp);
-  gauges.open(out / "gauges.csv", fmt::format("refined_wave ({}): eta (m) at x (m) = column suffix", refine));
+  gauges.open(out / "gauges.csv",
+              fmt::format("refined_wave (refine {}): eta (m) at x (m) = column suffix", refine ? "on" : "off"));
   io::CsvWriter counts_csv(out / "counts.csv", {"t", "fluid", "level0", "level1", "mass_change", "splits", "merges"},
                            "fluid particles per level (intermediate masses with the coarser), relative mass change");
   auto fluid_mass = [&] {

@@ -99,7 +99,7 @@ int main(int argc, char** argv) try {
   fluid.density_diffusion = cli.get_number("delta", 0.1, "delta-SPH coefficient");
   fluid.kinematic_viscosity = cli.get_number("viscosity", 0, "laminar kinematic viscosity nu, m^2/s");
   fluid.wall_artificial_viscosity =
-      cli.get("wall-viscosity", "off", "artificial viscosity between fluid and wall particles: on | off") == "on";
+      cli.get_switch("wall-viscosity", false, "artificial viscosity between fluid and wall particles: on | off");
   fluid.xsph = cli.get_number("xsph", fluid.xsph, "XSPH coefficient epsilon");
   const double max_period_error =
       cli.get_number("period-tolerance", 0, "pass: |period / linear theory - 1| at most this (0: no check)");
