@@ -7,12 +7,12 @@
 // each gauge once the wave train there has settled (ramp time + x / c_g + 4 periods: the SPH wave train builds up
 // more slowly than linear theory's, docs/flume.md). Checks: the height one wavelength from the paddle within 5 % of
 // the target, and the decay along the gauges from one wavelength on below 2 % per wavelength (fit of ln H against
-// x / L). Artificial viscosity acts between fluid particles only by default (--wall-viscosity off: no viscous
-// Stokes layer of the artificial viscosity on bed and paddle). The wave has Ursell number 20, so the piston is
-// driven with Madsen's (1971) second-order signal by default (--order 2): a first-order signal sheds a free second
-// harmonic whose beating with the bound one modulates H(x) by up to 9 % (waves/second_order.hpp). Each gauge's
-// height is also compared with second-order theory for the paddle signal used (the beating included for --order 1).
-// See docs/flume.md.
+// x / L). No artificial viscosity by default (--alpha 0; delta-SPH 0.1 keeps the pressure smooth); when it is
+// given, it acts between fluid particles only (--wall-viscosity off: no viscous Stokes layer on bed and paddle). The
+// wave has Ursell number 20, so the piston is driven with Madsen's (1971) second-order signal by default (--order 2): a
+// first-order signal sheds a free second harmonic whose beating with the bound one modulates H(x) by up to 9 %
+// (waves/second_order.hpp). Each gauge's height is also compared with second-order theory for the paddle signal used
+// (the beating included for --order 1). See docs/flume.md.
 #include <sphfsi/analysis/zero_crossing.hpp>
 #include <sphfsi/eos/tait.hpp>
 #include <sphfsi/integrators/simulation.hpp>
@@ -147,7 +147,7 @@ int run(const Options& o) {
   std::vector<double> t(gauges.times().begin(), gauges.times().end());
   io::CsvWriter heights(o.out / "wave_heights.csv",
                         {"x", "x_over_L", "H", "H_std", "H_over_target", "T", "waves", "H_theory_over_target"});
-  std::vector<double> xs, log_h;
+  std::vector<double> xs, log_h, log_h_error;
   double h_first = 0, t_first = 0;
   // the gauge nearest one wavelength from the paddle is the "generated height" gauge
   std::size_t first = 0;
@@ -183,13 +183,15 @@ int run(const Options& o) {
       if (i >= first) {
         xs.push_back(x / double(wave.wavelength));
         log_h.push_back(std::log(w.mean_height));
+        // standard error of ln H from the wave-to-wave scatter (waves treated as independent)
+        log_h_error.push_back(w.count() > 1 ? w.height_std / (w.mean_height * std::sqrt(double(w.count()))) : 0.0);
       }
     } catch (const InputError& e) {
       fmt::print("{:5d}  {:6.3f}  no complete wave after t = {:.2f} s ({})\n", i, double(gauge_x[i]), from, e.what());
     }
   }
   // decay per wavelength from the least-squares slope of ln H against x / L
-  double decay = std::numeric_limits<double>::quiet_NaN();
+  double decay = std::numeric_limits<double>::quiet_NaN(), decay_error = decay;
   if (xs.size() >= 2) {
     double mx = 0, my = 0;
     for (std::size_t i = 0; i < xs.size(); ++i) mx += xs[i], my += log_h[i];
@@ -198,12 +200,18 @@ int run(const Options& o) {
     for (std::size_t i = 0; i < xs.size(); ++i)
       sxy += (xs[i] - mx) * (log_h[i] - my), sxx += (xs[i] - mx) * (xs[i] - mx);
     decay = 1 - std::exp(sxy / sxx);
+    double slope_variance = 0;  // the slope is linear in ln H: sum of ((x_i - mean x) / sxx)^2 var(ln H_i)
+    for (std::size_t i = 0; i < xs.size(); ++i)
+      slope_variance += std::pow((xs[i] - mx) / sxx, 2) * log_h_error[i] * log_h_error[i];
+    decay_error = std::exp(sxy / sxx) * std::sqrt(slope_variance);
   }
   const double generated_error = h_first / double(g.wave.wave_height) - 1;
   fmt::print("generated height {:.2f} wavelengths from the paddle: {:+.1f} % of the target\n",
              double(gauge_x[first] / wave.wavelength), 100 * generated_error);
-  fmt::print("decay along the flume ({} gauges over {:.0f} wavelengths): {:.2f} % per wavelength\n", xs.size(),
-             xs.empty() ? 0.0 : xs.back() - xs.front(), 100 * decay);
+  fmt::print(
+      "decay along the flume ({} gauges over {:.0f} wavelengths): {:.2f} +- {:.2f} % per wavelength (standard error "
+      "from the wave-to-wave scatter at each gauge)\n",
+      xs.size(), xs.empty() ? 0.0 : xs.back() - xs.front(), 100 * decay, 100 * decay_error);
   const std::string plot =
       fmt::format("/usr/bin/python3 {}/examples/wave_flume/plot.py {}", SPHFSI_SOURCE_DIR, o.out.string());
   std::fflush(stdout);
@@ -238,16 +246,20 @@ int main(int argc, char** argv) try {
   g.smoothing_ratio =
       cli.get_number("smoothing", g.smoothing_ratio, "smoothing length over particle spacing, h_sph / dp");
   g.sound_speed_factor = cli.get_number("sound-speed", 7, "c0 / sqrt(g h)");
-  g.length_wavelengths = cli.get_number("length", 7, "flume length (paddle to end wall), wavelengths");
+  // 9 L: the damping zone (the last 1.5 L) starts 2.5 L past the last gauge; at 7 L its upstream influence lowered
+  // the gauge at 5 L by about 1.5 % (docs/flume.md, session 4).
+  g.length_wavelengths = cli.get_number("length", 9, "flume length (paddle to end wall), wavelengths");
   const std::string absorber = cli.get("absorber", "damping", "absorber: damping | beach | both");
   g.damping_wavelengths = cli.get_number("damping-length", 1.5, "damping zone length, wavelengths");
   g.damping_rate = cli.get_number("damping-rate", 10, "damping zone relaxation rate beta, 1/s");
   g.beach_slope = cli.get_number("beach-slope", 0.1, "beach slope, rise/run");
-  o.fluid.artificial_viscosity = cli.get_number("alpha", 0.01, "artificial viscosity alpha");
+  // alpha = 0: the artificial viscosity nu = alpha h_sph c0 / 8 takes 2 nu k^2 / c_g, about 1 % of the height per
+  // wavelength at alpha = 0.01; delta-SPH alone keeps the pressure smooth (docs/flume.md, session 5).
+  o.fluid.artificial_viscosity = cli.get_number("alpha", 0, "artificial viscosity alpha");
   o.fluid.density_diffusion = cli.get_number("delta", 0.1, "delta-SPH coefficient");
   o.fluid.kinematic_viscosity = cli.get_number("viscosity", 0, "laminar kinematic viscosity nu, m^2/s");
-  const std::string wall_viscosity =
-      cli.get("wall-viscosity", "off", "artificial viscosity between fluid and wall particles: on | off");
+  o.fluid.wall_artificial_viscosity =
+      cli.get_switch("wall-viscosity", false, "artificial viscosity between fluid and wall particles: on | off");
   o.gauges = int(cli.get_number("gauges", 5, "number of gauges, at 1, 2, ... n gauge spacings from the paddle"));
   o.gauge_spacing = cli.get_number("gauge-spacing", 1, "gauge spacing, wavelengths");
   o.waves_analysed = cli.get_number("waves", 3, "full-amplitude waves recorded at the last gauge");
@@ -267,9 +279,6 @@ int main(int argc, char** argv) try {
   if (paddle != "piston" && paddle != "flap")
     throw InputError(fmt::format("--paddle '{}': valid are piston, flap", paddle));
   g.wave.paddle = paddle == "piston" ? waves::PaddleType::piston : waves::PaddleType::flap;
-  if (wall_viscosity != "on" && wall_viscosity != "off")
-    throw InputError(fmt::format("--wall-viscosity '{}': valid are on, off", wall_viscosity));
-  o.fluid.wall_artificial_viscosity = wall_viscosity == "on";
   if (absorber == "damping") g.absorber = scenes::FlumeAbsorber::damping_zone;
   else if (absorber == "beach") g.absorber = scenes::FlumeAbsorber::beach;
   else if (absorber == "both") g.absorber = scenes::FlumeAbsorber::both;
