@@ -193,6 +193,8 @@ int main(int argc, char** argv) try {
       cli.get_number("solid-refinement", 1, "gate particle spacing dp / this: 1, 2 or 4 (finer solid than fluid)"));
   opt.scene.fluid_sound_speed = cli.get_number("fluid-sound-speed", 20, "fluid reference sound speed c0, m/s");
   opt.scene.youngs_modulus = cli.get_number("youngs-modulus", 1.2e7, "gate Young's modulus E, Pa");
+  opt.scene.smoothing_ratio =
+      cli.get_number("smoothing", opt.scene.smoothing_ratio, "smoothing length over spacing h / dp (fluid and gate)");
   const std::string plane = cli.get(
       "plane", "strain", "2D gate: strain (plane strain, a wide plate) | stress (plane stress, free to contract)");
   opt.end_time = cli.get_number("end-time", 0.4, "simulated time, s");

@@ -52,6 +52,7 @@ struct AntociGate {
     require_positive("AntociGate::fluid_density (kg/m^3)", fluid_density);
     require_positive("AntociGate::fluid_sound_speed (m/s)", fluid_sound_speed);
     require_in_range("AntociGate::particles_across (A/dp)", particles_across, T(20), T(2000));
+    require_in_range("AntociGate::smoothing_ratio (h/dp)", smoothing_ratio, T(1), T(3));
     require_in_range("AntociGate::clamp_rows", clamp_rows, 1, 10);
     if (solid_refinement != 1 && solid_refinement != 2 && solid_refinement != 4)
       throw InputError(
