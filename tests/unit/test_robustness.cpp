@@ -277,6 +277,7 @@ TEST_CASE("Robustness: every bad input of the public API is rejected, naming the
   });
   bad.expect("elastica_tip_load alpha", [] { analysis::elastica_tip_load(T(0)); });
   bad.expect("AntociGate::solid_refinement", [] { scenes::AntociGate<T>{.solid_refinement = 3}.validate(); });
+  bad.expect("AntociGate::smoothing_ratio", [] { scenes::AntociGate<T>{.smoothing_ratio = 0.5}.validate(); });
   bad.expect("Simulation::set_expected_flow_speed", [] {
     System2 s(tank_domain, water);
     Simulation<System2, SymplecticVerlet>(s, FluidParameters<2, T>{}).set_expected_flow_speed(0);
@@ -287,7 +288,7 @@ TEST_CASE("Robustness: every bad input of the public API is rejected, naming the
   INFO(bad.report());
   CHECK(bad.failures.empty());
   CHECK(bad.rejected == bad.tried);
-  CHECK(bad.tried == 89 + 23);  // keeps the list from silently shrinking
+  CHECK(bad.tried == 89 + 24);  // keeps the list from silently shrinking
 }
 
 // ---------------------------------------------------------------------------------------------------------------
