@@ -58,6 +58,7 @@ struct Options {
   T nominal_drag = 2.0;          // C_D used to choose E for a target Ca (the measured one is reported)
   T tow_lengths = 8;             // towing distance after the ramp, in blade lengths
   bool velocity_factor = false;  // eps(u_perp) of eq. 23: off, it rectifies the jitter of a light blade
+  T normal_damping = 0;          // beta of the coupling's normal dashpot (off: see docs/thin-blades.md)
   bool visibility = true;        // fluid pairs across the blade do not interact (fluid/thin_structure_visibility.hpp)
   bool global_step = false;      // true: the fluid steps with the rod's own stable step (no sub-cycling)
   T end_time = 0;                // s; 0: the ramp and the whole towing distance
@@ -121,6 +122,7 @@ CaseResult run_case(const Options& o, T target_ca) {
   fluid.thin_structure_visibility = o.visibility;
   RepulsiveForce<T> coupling;  // eq. 19 with k = 0.01: no hydrostatic load to balance here
   coupling.velocity_factor = o.velocity_factor;
+  coupling.normal_damping = o.normal_damping;
   // Sub-cycling (the default): the rod takes its own stable step inside each fluid step. With --global-step the fluid
   // is forced to the rod's step, so the rod takes one sub-step per fluid step (the reference for the saving).
   TimeStepParameters<T> time_step;
@@ -187,6 +189,8 @@ int main(int argc, char** argv) try {
   o.particles_along = cli.get_number("resolution", o.particles_along, "fluid particles along the blade, l / dp");
   o.tow_lengths = cli.get_number("tow-lengths", o.tow_lengths, "towing distance after the ramp, blade lengths");
   o.velocity_factor = cli.get_switch("velocity-factor", false, "eps(u_perp) of eq. 23 in the blade coupling: on | off");
+  o.normal_damping =
+      cli.get_number("normal-damping", 0, "beta of the blade coupling's normal dashpot (rate beta c0 / h), 0-1");
   o.visibility = cli.get_switch("visibility", true,
                                 "on: fluid pairs across the blade do not interact (visibility criterion) | off");
   o.global_step =

@@ -47,6 +47,7 @@ using namespace sphfsi;
 struct Options {
   scenes::PosidoniaFlume<double> scene;
   double alpha{0.01}, delta{0.1};
+  double cfl{0.2};  // CFL number of the fluid step
   double waves_analysed{4};
   double end_time{0};
   double snapshots{0};
@@ -82,6 +83,7 @@ scenes::PosidoniaFlume<T> converted(const scenes::PosidoniaFlume<double>& s) {
   c.equivalent_bulk_modulus = T(s.equivalent_bulk_modulus);
   c.rod_node_spacing = T(s.rod_node_spacing), c.rod_added_mass = T(s.rod_added_mass);
   c.rod_load_smoothing = s.rod_load_smoothing, c.rod_velocity_factor = s.rod_velocity_factor;
+  c.rod_normal_damping = T(s.rod_normal_damping);
   c.rod_repulsion = T(s.rod_repulsion);
   return c;
 }
@@ -107,9 +109,11 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
   fluid.density_diffusion = T(o.delta);
   fluid.thin_structure_visibility = o.visibility;
 
+  TimeStepParameters<T> stepping;
+  stepping.cfl = T(o.cfl);
   auto make_solver = [&]() {
     if constexpr (Rods) {
-      return Solver(system, fluid, {}, g.damping_zone(), scenes::add_posidonia_rods(system, scene, layout));
+      return Solver(system, fluid, stepping, g.damping_zone(), scenes::add_posidonia_rods(system, scene, layout));
     } else if constexpr (WithPlants) {
       typename Solid::Parameters params;
       params.gravity = Vec<2, T>(0, -g.wave.gravity);
@@ -120,9 +124,9 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
       RepulsiveForce<T> coupling;
       coupling.water_level = scene.depth;
       coupling.local_depth = scene.depth;
-      return Solver(system, fluid, {}, g.damping_zone(), Plant(coupling, std::move(blades)));
+      return Solver(system, fluid, stepping, g.damping_zone(), Plant(coupling, std::move(blades)));
     } else {
-      return Solver(system, fluid, {}, g.damping_zone());
+      return Solver(system, fluid, stepping, g.damping_zone());
     }
   };
   Solver sim = make_solver();
@@ -409,6 +413,8 @@ int main(int argc, char** argv) try {
   s.rod_added_mass = cli.get_number("added-mass", 1, "rod blade: added inertia per length and width / (rho_w dp)");
   s.rod_load_smoothing = int(cli.get_number("load-smoothing", 2, "rod blade: passes of the load filter"));
   s.rod_velocity_factor = cli.get_switch("velocity-factor", false, "rod blade: eq. 23 velocity factor on | off");
+  s.rod_normal_damping =
+      cli.get_number("normal-damping", 0.5, "rod blade: beta of the coupling's normal dashpot (rate beta c0 / h)");
   s.rod_repulsion =
       cli.get_number("repulsion", 0, "rod blade: k of eq. 19, A = k c0^2 / h (0: stops 3 x the orbital velocity)");
   s.poisson_ratio = cli.get_number("poisson", 0.3, "Poisson ratio of the real and scaled blade");
@@ -421,6 +427,7 @@ int main(int argc, char** argv) try {
                                 "each face's whole pressure: raise --repulsion) | off");
   o.alpha = cli.get_number("alpha", 0.01, "artificial viscosity alpha");
   o.delta = cli.get_number("delta", 0.1, "delta-SPH coefficient");
+  o.cfl = cli.get_number("cfl", 0.2, "CFL number of the fluid step (0, 1]");
   o.waves_analysed = cli.get_number("waves", 4, "full-amplitude waves recorded at the last gauge");
   o.end_time = cli.get_number("end-time", 0, "end time, s (0: from the waves to analyse at the last gauge)");
   o.snapshots = cli.get_number("snapshots", 20, "VTK snapshots per run (0: none)");

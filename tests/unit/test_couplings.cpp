@@ -16,9 +16,12 @@
 
 #include <catch2/catch.hpp>
 
+#include <cmath>
+#include <numbers>
 #include <random>
 
 using namespace sphfsi;
+using Catch::Matchers::WithinRel;
 
 namespace {
 
@@ -98,6 +101,48 @@ TEST_CASE("interface pressure conserves fluid-solid momentum", "[coupling]") {
 TEST_CASE("repulsive force conserves fluid-solid momentum", "[coupling]") {
   RepulsiveForce<double> c;
   check_coupling(c);
+}
+
+TEST_CASE("repulsive force with the normal dashpot conserves fluid-solid momentum", "[coupling]") {
+  RepulsiveForce<double> c;
+  c.normal_damping = 0.5;
+  check_coupling(c);
+}
+
+TEST_CASE("normal dashpot: opposes the normal relative velocity both ways, ignores the tangential one, dissipates",
+          "[coupling]") {
+  const double h = 0.01, c0 = 10, q = 0.3, beta = 0.5;
+  RepulsiveForceParameters<double> params;
+  params.boundary_spacing = 0.005;
+  params.strength = 1e-4;
+  params.velocity_factor = false;  // eq. 23 off: the dashpot is then the only velocity-dependent term
+  params.normal_damping = beta;
+  const V n(0, 1), t(1, 0);
+  const V dx = 2 * h * q * n + 0.3 * params.boundary_spacing * t;  // inside the range, off the node's normal
+  const double P = 0.5 * (1 + std::cos(std::numbers::pi * 0.3));   // eq. 20 at xi = 0.3 db
+  const V at_rest = repulsive_force<2, double>(dx, V::Zero(), n, h, c0, 0.0, params);
+  const double u = 0.2;
+  const V receding = repulsive_force<2, double>(dx, u * n, n, h, c0, 0.0, params) - at_rest;
+  const V approaching = repulsive_force<2, double>(dx, -u * n, n, h, c0, 0.0, params) - at_rest;
+  const V sliding = repulsive_force<2, double>(dx, u * t, n, h, c0, 0.0, params) - at_rest;
+  // a = -beta (c0 / h) (1 - q) P (dv . n) n: symmetric (not one-sided like eq. 23), normal, of known size
+  const double expected = beta * (c0 / h) * (1 - q) * P * u;
+  CHECK_THAT(approaching.dot(n), WithinRel(expected, 1e-12));
+  CHECK_THAT(receding.dot(n), WithinRel(-expected, 1e-12));
+  CHECK(std::abs(approaching.dot(t)) <= 1e-15 * expected);
+  CHECK(sliding.norm() <= 1e-15 * expected);
+  // the pair's power, a_f . (v_f - v_s) (the solid receives -m_f a_f), is never positive
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> w(-1, 1);
+  for (int k = 0; k < 100; ++k) {
+    const V dv(w(rng), w(rng));
+    CHECK((repulsive_force<2, double>(dx, dv, n, h, c0, 0.0, params) - at_rest).dot(dv) <= 0);
+  }
+  // off (beta = 0): the force of eqs 17-22 does not depend on the velocity
+  params.normal_damping = 0;
+  CHECK((repulsive_force<2, double>(dx, V(0.3, -0.4), n, h, c0, 0.0, params) -
+         repulsive_force<2, double>(dx, V::Zero(), n, h, c0, 0.0, params))
+            .norm() == 0);
 }
 
 TEST_CASE("solid surface normals point out of a block", "[coupling]") {
@@ -220,6 +265,36 @@ TEST_CASE("repulsive force on a thin blade: pushes on both faces and conserves m
   const V p0 = momentum(system);
   double scale_p = 0;
   for (std::size_t i = 0; i < p.size(); ++i) scale_p += p.mass[i] * p.velocity[i].norm();
+  for (int k = 0; k < 30; ++k) sim.step();
+  CHECK((momentum(system) - p0).norm() <= 1e-12 * scale_p);
+}
+
+TEST_CASE("repulsive force on a thin blade with the normal dashpot conserves momentum", "[coupling][thin]") {
+  // The free blade between two fluid blocks with random velocities (above), the dashpot on.
+  System system(Domain<2, double>(V(-0.2, -0.2), V(0.3, 0.3)), Tait<double>(1000, 20));
+  const Resolution<double> res{0.005, 1.3};
+  add_fluid_block(system, V(0, 0), V(0.05, 0.06), res, 0.06, 9.81);
+  add_fluid_block(system, V(0.055, 0), V(0.1, 0.06), res, 0.06, 9.81);
+  add_elastic_rod(system, V(0.0525, 0.0), V(0, 1), 0.06, 25, blade_material(), blade_section(), res.h(), 1);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-0.2, 0.2);
+  for (auto& v : system.particles().velocity) v = V(u(rng), u(rng));
+  Rod::Parameters params;
+  params.section = blade_section();
+  params.gravity = V::Zero();
+  // no added inertia (it would make sum m v not the conserved momentum): the blade is 50 times lighter than the
+  // fluid particles, and the dashpot's own step limit (RepulsiveForce::stable_time_step) keeps it stable
+  FluidParameters<2, double> fluid;
+  fluid.gravity = V::Zero();
+  RepulsiveForce<double> coupling;
+  coupling.normal_damping = 0.5;
+  using Body = CoupledBody<RepulsiveForce<double>, Rod>;
+  Simulation<System, SymplecticVerlet, Body> sim(system, fluid, {},
+                                                 Body(coupling, Rod(system, 1, blade_material(), params)));
+  const V p0 = momentum(system);
+  double scale_p = 0;
+  for (std::size_t i = 0; i < system.size(); ++i)
+    scale_p += system.particles().mass[i] * system.particles().velocity[i].norm();
   for (int k = 0; k < 30; ++k) sim.step();
   CHECK((momentum(system) - p0).norm() <= 1e-12 * scale_p);
 }

@@ -268,6 +268,7 @@ TEST_CASE("Robustness: every bad input of the public API is rejected, naming the
              [] { UpdatedLagrangianParameters<2, T>{.artificial_stress = 2}.validate(); });
   bad.expect("RepulsiveForce::range_factor", [] { RepulsiveForce<T>{.range_factor = 10}.validate(); });
   bad.expect("RepulsiveForce::strength", [] { RepulsiveForce<T>{.strength = 0}.validate(); });
+  bad.expect("RepulsiveForce::normal_damping", [] { RepulsiveForce<T>{.normal_damping = -0.1}.validate(); });
   bad.expect("RodSection::thickness", [] { RodSection<T>{.thickness = 0}.validate(); });
   bad.expect("RodSection::width", [] { RodSection<T>{.thickness = 1e-4, .width = -1}.validate(); });
   bad.expect("ElasticRodParameters::cfl", [] { ElasticRodParameters<T>{.cfl = 2}.validate(); });
@@ -288,7 +289,7 @@ TEST_CASE("Robustness: every bad input of the public API is rejected, naming the
   INFO(bad.report());
   CHECK(bad.failures.empty());
   CHECK(bad.rejected == bad.tried);
-  CHECK(bad.tried == 89 + 24);  // keeps the list from silently shrinking
+  CHECK(bad.tried == 89 + 25);  // keeps the list from silently shrinking
 }
 
 // ---------------------------------------------------------------------------------------------------------------

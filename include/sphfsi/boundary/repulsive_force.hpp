@@ -24,6 +24,16 @@
 // (eps(z) = 1: the full push at every depth, which keeps the free surface a little further than dp/2 from side
 // walls but needs no knowledge of the water level). For a tank of still-water depth D: water_level = bed + D,
 // local_depth = D.
+//
+// Normal dashpot (sphfsi's addition, off by default: normal_damping = 0). The repulsion depends on position only; a
+// very light thin blade (a real seagrass blade, 0.1 mm) has almost no inertia and bending stiffness to hold against
+// the noise of that push from its two faces, and the SPH fluid is one fluid across it, so nothing ties the blade's
+// motion to the water's: it drifts over in still water (docs/posidonia.md, session 6). The dashpot imposes the
+// impermeability condition weakly, in the normal relative velocity of each pair:
+//   a_f += -beta (c0 / h) (1 - q) P(xi) ((v_f - v_b) . n) n
+// (the boundary particle receives the reaction), symmetric in approach and recession (unlike eq. 23's one-sided
+// factor), free-slip along the boundary, and dissipative for every pair (power -m_f beta (c0/h) (1-q) P (dv.n)^2).
+// It is explicit: the coupling limits the step to 2 / lambda (coupling/repulsive_force.hpp).
 #pragma once
 
 #include <sphfsi/core/error.hpp>
@@ -44,6 +54,7 @@ struct RepulsiveForceParameters {
   int vertical_axis{1};        ///< axis of z (1 in 2D, 2 in 3D)
   T strength{T(0.01)};         ///< coefficient k of A = k c0^2 / h (eq. 19: 0.01), > 0
   bool velocity_factor{true};  ///< eps(u_perp) of eq. 23 (false: eps = eps(z) only; see RepulsiveForce)
+  T normal_damping{T(0)};      ///< beta of the normal dashpot (rate beta c0 / h; see the header comment), [0, 1]
 
   /// Throws InputError naming the first parameter out of range.
   void validate() const {
@@ -52,6 +63,7 @@ struct RepulsiveForceParameters {
     require_finite("RepulsiveForceParameters::local_depth (h0, m)", local_depth);
     require_in_range("RepulsiveForceParameters::vertical_axis", vertical_axis, 0, 2);
     require_positive("RepulsiveForceParameters::strength (k of A = k c0^2 / h)", strength);
+    require_in_range("RepulsiveForceParameters::normal_damping (beta)", normal_damping, T(0), T(1));
   }
 };
 
@@ -109,7 +121,8 @@ inline Vec<Dim, T> repulsive_force(const Vec<Dim, T>& dx, const Vec<Dim, T>& dv,
   const T P = T(0.5) * (T(1) + std::cos(std::numbers::pi_v<T> * xi / params.boundary_spacing));  // (20)
   const T eps = repulsive_depth_factor(elevation, params.local_depth) +
                 (params.velocity_factor ? repulsive_velocity_factor(dv.dot(n), c0) : T(0));  // (21)
-  return n * (R * P * eps);                                                                  // (17)
+  // (17), and the normal dashpot that drives the normal relative velocity to zero (impermeability)
+  return n * (R * P * eps - params.normal_damping * (c0 / h) * (T(1) - q) * P * dv.dot(n));
 }
 
 }  // namespace sphfsi

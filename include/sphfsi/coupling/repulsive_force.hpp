@@ -19,6 +19,9 @@
 #include <sphfsi/core/types.hpp>
 #include <sphfsi/coupling/solid_surface.hpp>
 
+#include <algorithm>
+#include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace sphfsi {
@@ -36,11 +39,42 @@ struct RepulsiveForce {
   /// measured in examples/blade_in_current (docs/thin-blades.md), it raised a flexible blade's drag above the
   /// rigid blade's. false: eps = eps(z) only.
   bool velocity_factor{true};
+  /// beta of the normal dashpot: the fluid particle's velocity normal to the solid, relative to the solid particle,
+  /// relaxes at the rate beta (c0 / h) (1 - q) P(xi), and the solid receives the reaction
+  /// (boundary/repulsive_force.hpp). 0: none (the paper's eqs 17-23).
+  T normal_damping{T(0)};
 
   void validate() const {
     require_non_negative("RepulsiveForce::sound_speed (m/s)", sound_speed);
     require_in_range("RepulsiveForce::range_factor", range_factor, T(0.5), T(3));
     require_positive("RepulsiveForce::strength (k of A = k c0^2 / h)", strength);
+    require_in_range("RepulsiveForce::normal_damping (beta)", normal_damping, T(0), T(1));
+  }
+
+  /// The normal dashpot is explicit: the relative normal velocity of a fluid-solid pair relaxes at about
+  /// lambda = beta (c0 / h) (1 + 2 m_f / m_s) (the solid particle meets fluid on both faces of a thin structure; m_s
+  /// includes a rod's added inertia),
+  /// stable for lambda dt < 2. Returns 2 / lambda over the solid's fluid neighbours (the Simulation applies its CFL
+  /// factor to it); without the dashpot the repulsion sets no step of its own here (infinity).
+  template <class System, class Solid>
+  T stable_time_step(const System& system, const Solid& solid) const {
+    T dt = std::numeric_limits<T>::infinity();
+    if (normal_damping <= T(0)) return dt;
+    const auto& p = system.particles();
+    const T c0 = sound_speed > T(0) ? sound_speed : system.eos().reference_sound_speed();
+    const auto& ids = solid.particle_ids();
+    for (std::size_t k = 0; k < ids.size(); ++k) {
+      const std::size_t s = p.slot_of_id(ids[k]);
+      // a solid with added inertia (ElasticRod::inertia_ratios) accelerates by only this share of m_f a_f / m_s
+      T share = T(1);
+      if constexpr (requires { solid.inertia_ratios(); }) share = solid.inertia_ratios()[k];
+      system.for_each_neighbor(s, [&](std::size_t f, const auto&, T, T h) {
+        if (p.kind[f] != Kind::fluid) return;
+        const T rate = normal_damping * (c0 / h) * (T(1) + T(2) * share * p.mass[f] / p.mass[s]);
+        dt = std::min(dt, T(2) / rate);
+      });
+    }
+    return dt;
   }
 
   template <class System, class Solid>
@@ -60,6 +94,7 @@ struct RepulsiveForce {
     params.vertical_axis = up;
     params.strength = strength;
     params.velocity_factor = velocity_factor;
+    params.normal_damping = normal_damping;
     const T c0 = sound_speed > T(0) ? sound_speed : system.eos().reference_sound_speed();
     for (std::size_t k = 0; k < ids.size(); ++k) {
       if (!surface[k]) continue;

@@ -137,6 +137,10 @@ struct RodBladeCoupling {
     // load on a wall) would weaken the push near the surface, and eq. 23's velocity factor rectifies a light
     // blade's jitter (docs/thin-blades.md)
     coupling.velocity_factor = false;
+    // the normal dashpot locks the blade's normal velocity to the adjacent fluid's (impermeability): without it the
+    // blade has almost no restoring force against the noise of the repulsion on its two faces (the fluid is one
+    // fluid across it in the SPH sums, and E t^3 / 12 is tiny) and drifts over in still water (docs/posidonia.md)
+    coupling.normal_damping = T(0.5);
   }
 };
 

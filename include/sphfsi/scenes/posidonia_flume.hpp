@@ -79,6 +79,7 @@ struct PosidoniaFlume {
   T rod_added_mass{T(1)};             ///< rod blade: added inertia per length and width / (rho_w dp) (meadow.hpp)
   int rod_load_smoothing{2};          ///< rod blade: passes of the load filter along the blade (meadow.hpp)
   bool rod_velocity_factor{false};    ///< rod blade: eq. 23's velocity factor in the coupling
+  T rod_normal_damping{T(0.5)};       ///< rod blade: beta of the coupling's normal dashpot (rate beta c0 / h)
   T rod_repulsion{T(0)};              ///< rod blade: k of eq. 19 (0: to stop 3 x the surface orbital velocity)
 
   void validate() const {
@@ -243,6 +244,7 @@ RodBlades<System> add_posidonia_rods(System& system, const PosidoniaFlume<typena
   how.added_mass_ratio = scene.rod_added_mass;
   how.load_smoothing_passes = scene.rod_load_smoothing;
   how.coupling.velocity_factor = scene.rod_velocity_factor;
+  how.coupling.normal_damping = scene.rod_normal_damping;
   if (scene.rod_repulsion > T(0)) how.coupling.strength = scene.rod_repulsion;
   else how.stopping_speed = T(3) * waves::Wavemaker<T>(g.wave).wave().surface_orbital_velocity(scene.wave_height);
   if (scene.blade != BladeModel::rod)

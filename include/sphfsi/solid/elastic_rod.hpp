@@ -379,6 +379,9 @@ class ElasticRod {
   const std::vector<Vector>& velocities() const noexcept { return v_; }
   /// Node masses m_i = rho A D_i of the real blade (width b), kg.
   const std::vector<T>& node_masses() const noexcept { return mass_; }
+  /// Per node, m_i / (m_i + m_a b D_i): the share of a force on the node's own mass that becomes its acceleration
+  /// (1 without added inertia). Couplings use it for their step limit (coupling/repulsive_force.hpp).
+  const std::vector<T>& inertia_ratios() const noexcept { return inertia_ratio_; }
   /// E_r: E, or E / (1 - nu^2) in plane strain, Pa.
   T modulus() const { return params_.plane_strain ? material_.plane_strain_modulus() : material_.youngs_modulus; }
   /// Flexural rigidity E_r I, N m^2.
