@@ -66,7 +66,8 @@ struct Options {
   T waves_analysed = 4, end_time = 0, snapshots = 0;
   T added_mass = 1, node_spacing = 1;       // rods: m_a / (rho_w dp), ds / dp
   int load_smoothing = 2, blade_count = 0;  // 0: the meadow's length / dx_b
-  T normal_damping = 0.5;                   // beta of the blade coupling's normal dashpot
+  // beta of the blade coupling's normal dashpot (off: it makes the 2D blades a dam, docs/meadow.md)
+  T normal_damping = 0;
   bool run_meadow = true, run_empty = true, check = false;
   // Fluid pairs across a blade interact (false: the 2D full-width blades every 3 dp would otherwise be a dam that
   // holds the whole wave pressure difference; see docs/meadow.md), and the weak repulsion that stops the fluid.
@@ -291,8 +292,9 @@ int main(int argc, char** argv) try {
   o.added_mass = cli.get_number("added-mass", 1, "rod added inertia per length and width / (rho_w dp)");
   o.node_spacing = cli.get_number("rod-spacing", 1, "rod node spacing / dp");
   o.load_smoothing = int(cli.get_number("load-smoothing", 2, "passes of the load filter along each blade"));
-  o.normal_damping =
-      cli.get_number("normal-damping", 0.5, "beta of the blade coupling's normal dashpot (rate beta c0 / h), 0-1");
+  o.normal_damping = cli.get_number(
+      "normal-damping", 0,
+      "beta of the blade coupling's normal dashpot (rate beta c0 / h), 0-1 (0.5: the blades are impermeable)");
   o.flexural_rigidity = cli.get_number("rigidity", 7.5e-8, "flexural rigidity EI of one blade, N m^2");
   const std::string runs = cli.get("runs", "both", "runs: both | meadow | empty");
   o.visibility =

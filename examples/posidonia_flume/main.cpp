@@ -62,6 +62,7 @@ struct Options {
 struct CaseResult {
   std::vector<double> height, height_std, period;  // per gauge (NaN where no complete wave)
   std::vector<double> tip_dx_amplitude, tip_dz_amplitude, tip_dx_mean, tip_dz_mean;  // per plant, m
+  std::vector<double> water_dx_amplitude, water_dx_mean;  // the water beside each tip, per plant, m
   std::size_t fluid{0}, wall{0}, solid{0}, steps{0}, solid_sub_steps{0}, fluid_inside_max{0}, crossings{0};
   double lowest_node{std::numeric_limits<double>::quiet_NaN()};  // rods: lowest free node above the bed, m
   double wall_seconds{0}, end_time{0}, reached{0}, max_stretch{1};
@@ -161,6 +162,12 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
     tip_columns.push_back(fmt::format("dx_{}", k));
     tip_columns.push_back(fmt::format("dz_{}", k));
   }
+  // the water beside each tip: mean displacement of the fluid particles that start within 1.5 dp of it (a passive
+  // blade cannot move further than this water)
+  for (std::size_t k = 0; k < plant_count; ++k) {
+    tip_columns.push_back(fmt::format("water_dx_{}", k));
+    tip_columns.push_back(fmt::format("water_dz_{}", k));
+  }
   std::optional<io::CsvWriter> tips_csv;
   if (WithPlants)
     tips_csv.emplace(dir / "tips.csv", tip_columns,
@@ -174,8 +181,23 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
   };
   std::vector<Vec<2, T>> tip0;
   for (std::size_t k = 0; k < plant_count; ++k) tip0.push_back(tip_position(system, k));
+  std::vector<std::vector<std::uint32_t>> water_ids(plant_count);
+  std::vector<std::vector<Vec<2, T>>> water0(plant_count);
+  for (std::size_t k = 0; k < plant_count; ++k)
+    for (std::size_t i = 0; i < system.size(); ++i)
+      if (system.particles().kind[i] == Kind::fluid &&
+          (system.particles().position[i] - tip0[k]).norm() < T(1.5) * scene.dp()) {
+        water_ids[k].push_back(system.particles().id[i]);
+        water0[k].push_back(system.particles().position[i]);
+      }
+  auto water_displacement = [&](const System& s, std::size_t k) {
+    Vec<2, T> d = Vec<2, T>::Zero();
+    for (std::size_t j = 0; j < water_ids[k].size(); ++j)
+      d += s.particles().position[s.particles().slot_of_id(water_ids[k][j])] - water0[k][j];
+    return Vec<2, T>(water_ids[k].empty() ? d : Vec<2, T>(d / T(water_ids[k].size())));
+  };
   std::vector<double> times;
-  std::vector<std::vector<double>> tip_dx(plant_count), tip_dz(plant_count);
+  std::vector<std::vector<double>> tip_dx(plant_count), tip_dz(plant_count), water_dx(plant_count);
   scenes::BladeCrossingCounter<System> crossings(T(1.5) * scene.dp());
 
   io::VtkSeriesWriter vtk(dir, "posidonia_flume");
@@ -197,6 +219,12 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
             row.push_back(double(d[1]));
             tip_dx[k].push_back(double(d[0]));
             tip_dz[k].push_back(double(d[1]));
+          }
+          for (std::size_t k = 0; k < plant_count; ++k) {
+            const Vec<2, T> w = water_displacement(sm.system(), k);
+            row.push_back(double(w[0]));
+            row.push_back(double(w[1]));
+            water_dx[k].push_back(double(w[0]));
           }
           tips_csv->write_row(row);
           if constexpr (Rods) {
@@ -254,18 +282,22 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
     const double from =
         double(maker.ramp_time()) + double(layout.plant_x[k]) / double(wave.group_velocity) + double(wave.period);
     double lo_x = 1e9, hi_x = -1e9, lo_z = 1e9, hi_z = -1e9, sum_x = 0, sum_z = 0;
+    double lo_w = 1e9, hi_w = -1e9, sum_w = 0;
     std::size_t n = 0;
     for (std::size_t j = 0; j < times.size(); ++j) {
       if (times[j] < from) continue;
       lo_x = std::min(lo_x, tip_dx[k][j]), hi_x = std::max(hi_x, tip_dx[k][j]);
       lo_z = std::min(lo_z, tip_dz[k][j]), hi_z = std::max(hi_z, tip_dz[k][j]);
-      sum_x += tip_dx[k][j], sum_z += tip_dz[k][j], ++n;
+      lo_w = std::min(lo_w, water_dx[k][j]), hi_w = std::max(hi_w, water_dx[k][j]);
+      sum_x += tip_dx[k][j], sum_z += tip_dz[k][j], sum_w += water_dx[k][j], ++n;
     }
     const double nan = std::numeric_limits<double>::quiet_NaN();
     r.tip_dx_amplitude.push_back(n ? 0.5 * (hi_x - lo_x) : nan);
     r.tip_dz_amplitude.push_back(n ? 0.5 * (hi_z - lo_z) : nan);
     r.tip_dx_mean.push_back(n ? sum_x / double(n) : nan);
     r.tip_dz_mean.push_back(n ? sum_z / double(n) : nan);
+    r.water_dx_amplitude.push_back(n ? 0.5 * (hi_w - lo_w) : nan);
+    r.water_dx_mean.push_back(n ? sum_w / double(n) : nan);
   }
   return r;
 }
@@ -348,6 +380,10 @@ int run(const Options& o) {
       fmt::print("  plant {} at x = {:.3f} m: |dx| {:.2f} mm, |dz| {:.2f} mm; mean dx {:+.2f} mm, dz {:+.2f} mm\n", k,
                  double(scene.plant_x()[k]), 1e3 * with.tip_dx_amplitude[k], 1e3 * with.tip_dz_amplitude[k],
                  1e3 * with.tip_dx_mean[k], 1e3 * with.tip_dz_mean[k]);
+    fmt::print("the water beside each tip (fluid particles that started within 1.5 dp of it):\n");
+    for (std::size_t k = 0; k < with.water_dx_amplitude.size(); ++k)
+      fmt::print("  plant {}: |dx| {:.2f} mm, mean dx {:+.2f} mm\n", k, 1e3 * with.water_dx_amplitude[k],
+                 1e3 * with.water_dx_mean[k]);
     fmt::print(
         "plants run: {} + {} + {} particles, {} steps, {} solid sub-steps, {:.1f} s wall; max stretch {:.3f}, "
         "fluid particles inside the blades (max) {}; fluid particles that crossed a rod blade {}; lowest rod node "
