@@ -39,10 +39,12 @@ unset(_sphfsi_sanitize)
 # The same solid loops run here in the rigid-rotation, sub-cycling, clamp, ULSPH energy, checkpoint and TLSPH
 # plate-period cases of test_solids.cpp and test_solid_checkpoint.cpp. (Several specs given to Catch are AND-ed.)
 # The refined still tank (test_particle_refinement.cpp, 11 s release) is left out too; its splitting, merging, particle
-# removal and checkpoint paths run here in the other refinement cases.
+# removal and checkpoint paths run here in the other refinement cases. So is the Posidonia blade in the still flume
+# (test_posidonia_flume.cpp, 8 s of simulated flume, 30 CPU s at -O2); its rod, dashpot and crossing-counter code runs
+# here in the coupling and rod-blade cases.
 set(SPHFSI_SANITIZER_EXCLUDED_CASES "~TLSPH: energy of the undamped oscillating plate*"
                                     "~Solid models conserve momentum in a free*" "~ULSPH: oscillating plate period*"
-                                    "~hydrostatic tank with a refined band*")
+                                    "~hydrostatic tank with a refined band*" "~a real Posidonia blade stands*")
 add_test(NAME sanitizer.unit_tests COMMAND sphfsi_unit_tests_sanitized ${SPHFSI_SANITIZER_EXCLUDED_CASES})
 set_tests_properties(sanitizer.unit_tests PROPERTIES
   LABELS sanitizer
