@@ -10,6 +10,7 @@
 // examples/wave_flume (h = 0.16 m, T = 1.4286 s: L = 1.695 m, H = 2a = 0.028 m) with its scheme (Wendland C2,
 // h_sph = 2 dp, c0 = 7 sqrt(g h), alpha = 0.01 between fluid particles, delta-SPH 0.1, dynamic walls), so that a
 // sweep over the flags separates the causes of the flume's wave loss (docs/flume.md).
+#include <sphfsi/analysis/line_fit.hpp>
 #include <sphfsi/analysis/zero_crossing.hpp>
 #include <sphfsi/core/particle_system.hpp>
 #include <sphfsi/eos/tait.hpp>
@@ -73,13 +74,9 @@ EnvelopeFit fit_envelope(const std::vector<double>& t, const std::vector<double>
   EnvelopeFit fit;
   fit.extremes = te.size();
   if (te.size() < 3) throw InputError("standing_wave: fewer than 3 crests and troughs recorded: run longer");
-  double mt = 0, my = 0;
-  for (std::size_t i = 0; i < te.size(); ++i) mt += te[i], my += ln_a[i];
-  mt /= double(te.size()), my /= double(te.size());
-  double sxy = 0, sxx = 0;
-  for (std::size_t i = 0; i < te.size(); ++i) sxy += (te[i] - mt) * (ln_a[i] - my), sxx += (te[i] - mt) * (te[i] - mt);
-  fit.decay_rate = -sxy / sxx;
-  fit.amplitude = std::exp(my + fit.decay_rate * mt);
+  const analysis::LineFit line = analysis::fit_line(te, ln_a);
+  fit.decay_rate = -line.slope;
+  fit.amplitude = std::exp(line.intercept);
   return fit;
 }
 

@@ -13,6 +13,7 @@
 // first-order signal sheds a free second harmonic whose beating with the bound one modulates H(x) by up to 9 %
 // (waves/second_order.hpp). Each gauge's height is also compared with second-order theory for the paddle signal used
 // (the beating included for --order 1). See docs/flume.md.
+#include <sphfsi/analysis/line_fit.hpp>
 #include <sphfsi/analysis/zero_crossing.hpp>
 #include <sphfsi/eos/tait.hpp>
 #include <sphfsi/integrators/simulation.hpp>
@@ -190,20 +191,12 @@ int run(const Options& o) {
       fmt::print("{:5d}  {:6.3f}  no complete wave after t = {:.2f} s ({})\n", i, double(gauge_x[i]), from, e.what());
     }
   }
-  // decay per wavelength from the least-squares slope of ln H against x / L
+  // decay per wavelength from the least-squares slope of ln H against x / L, its error from the wave-to-wave scatter
   double decay = std::numeric_limits<double>::quiet_NaN(), decay_error = decay;
   if (xs.size() >= 2) {
-    double mx = 0, my = 0;
-    for (std::size_t i = 0; i < xs.size(); ++i) mx += xs[i], my += log_h[i];
-    mx /= double(xs.size()), my /= double(xs.size());
-    double sxy = 0, sxx = 0;
-    for (std::size_t i = 0; i < xs.size(); ++i)
-      sxy += (xs[i] - mx) * (log_h[i] - my), sxx += (xs[i] - mx) * (xs[i] - mx);
-    decay = 1 - std::exp(sxy / sxx);
-    double slope_variance = 0;  // the slope is linear in ln H: sum of ((x_i - mean x) / sxx)^2 var(ln H_i)
-    for (std::size_t i = 0; i < xs.size(); ++i)
-      slope_variance += std::pow((xs[i] - mx) / sxx, 2) * log_h_error[i] * log_h_error[i];
-    decay_error = std::exp(sxy / sxx) * std::sqrt(slope_variance);
+    const analysis::LineFit fit = analysis::fit_line(xs, log_h, log_h_error);
+    decay = 1 - std::exp(fit.slope);
+    decay_error = std::exp(fit.slope) * fit.slope_error;
   }
   const double generated_error = h_first / double(g.wave.wave_height) - 1;
   fmt::print("generated height {:.2f} wavelengths from the paddle: {:+.1f} % of the target\n",

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <sphfsi/analysis/elastica.hpp>
+#include <sphfsi/analysis/line_fit.hpp>
 #include <sphfsi/analysis/vegetation_drag.hpp>
 #include <sphfsi/analysis/zero_crossing.hpp>
 #include <sphfsi/boundary/repulsive_force.hpp>

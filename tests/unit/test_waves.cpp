@@ -1,5 +1,6 @@
 // Tests of the wave flume tools: linear theory and Biesel transfer functions, the wavemaker's motion, zero-crossing
 // analysis, the Dalrymple et al. (1984) decay fit and drag-coefficient inversion, the damping zone and the gauges.
+#include <sphfsi/analysis/line_fit.hpp>
 #include <sphfsi/analysis/vegetation_drag.hpp>
 #include <sphfsi/analysis/zero_crossing.hpp>
 #include <sphfsi/eos/tait.hpp>
@@ -364,4 +365,37 @@ TEST_CASE("wave gauge: the surface of a still flume at the still-water level", "
   CHECK_FALSE(waves::gauge_position("t").has_value());
   gauges.sample(system, 0.0);
   CHECK(gauges.series(0).size() == 1);
+}
+
+TEST_CASE("fit_line: an exact line, the slope's standard error against Monte Carlo, and bad input",
+          "[waves][analysis]") {
+  const std::vector<double> x{0, 1, 2, 3, 4};
+  std::vector<double> y;
+  for (double xi : x) y.push_back(0.5 - 0.02 * xi);
+  const auto exact = analysis::fit_line(x, y);
+  CHECK_THAT(exact.slope, WithinAbs(-0.02, 1e-15));
+  CHECK_THAT(exact.intercept, WithinAbs(0.5, 1e-15));
+  CHECK(exact.points == 5);
+  CHECK(std::isnan(exact.slope_error));
+  // errors s_i: var(slope) = sum ((x_i - 2) / 10)^2 s_i^2; with s = 0.01 at every point, s / sqrt(10)
+  const std::vector<double> s(5, 0.01);
+  CHECK_THAT(analysis::fit_line(x, y, s).slope_error, WithinRel(0.01 / std::sqrt(10.0), 1e-12));
+  // the same against the scatter of 20,000 noisy fits (relative standard error of a standard deviation from
+  // n samples: 1 / sqrt(2 n) = 0.5 %; 3 % allows six of them)
+  std::mt19937 rng(17);
+  std::normal_distribution<double> noise(0, 0.01);
+  double sum = 0, sum2 = 0;
+  const int n = 20000;
+  for (int k = 0; k < n; ++k) {
+    std::vector<double> yk = y;
+    for (double& v : yk) v += noise(rng);
+    const double b = analysis::fit_line(x, yk).slope;
+    sum += b, sum2 += b * b;
+  }
+  const double sd = std::sqrt(sum2 / n - (sum / n) * (sum / n));
+  CHECK_THAT(sd, WithinRel(0.01 / std::sqrt(10.0), 0.03));
+  CHECK_THROWS_AS(analysis::fit_line({1.0}, {2.0}), InputError);
+  CHECK_THROWS_AS(analysis::fit_line({1.0, 1.0}, {2.0, 3.0}), InputError);
+  CHECK_THROWS_AS(analysis::fit_line({1.0, 2.0}, {2.0}), InputError);
+  CHECK_THROWS_AS(analysis::fit_line({1.0, 2.0}, {2.0, 3.0}, {0.1}), InputError);
 }
