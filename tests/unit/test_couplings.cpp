@@ -224,26 +224,52 @@ ElasticMaterial<double> blade_material() {
 
 RodSection<double> blade_section() { return RodSection<double>{.thickness = 4e-4, .width = 0.01}; }
 
-}  // namespace
-
-TEST_CASE("repulsive force on a thin blade: pushes on both faces and conserves momentum", "[coupling][thin]") {
-  // A free blade (no clamp, no gravity) between two fluid blocks with random velocities: every force is a pair force.
+// A free blade (no clamp, no gravity) between two fluid blocks with random velocities: every force is a pair force.
+System blade_between_blocks(unsigned seed) {
   System system(Domain<2, double>(V(-0.2, -0.2), V(0.3, 0.3)), Tait<double>(1000, 20));
   const Resolution<double> res{0.005, 1.3};
   add_fluid_block(system, V(0, 0), V(0.05, 0.06), res, 0.06, 9.81);
   add_fluid_block(system, V(0.055, 0), V(0.1, 0.06), res, 0.06, 9.81);
   add_elastic_rod(system, V(0.0525, 0.0), V(0, 1), 0.06, 25, blade_material(), blade_section(), res.h(), 1);
-  std::mt19937 rng(3);
+  std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-0.2, 0.2);
   for (auto& v : system.particles().velocity) v = V(u(rng), u(rng));
+  return system;
+}
+
+// The free blade's rod, without added inertia (with it, sum m v would not be the conserved momentum).
+Rod free_blade(const System& system) {
   Rod::Parameters params;
   params.section = blade_section();
   params.gravity = V::Zero();
+  return Rod(system, 1, blade_material(), params);
+}
+
+// 30 coupled steps with the sub-cycled blade keep the total momentum to round-off.
+template <class Sim>
+void check_momentum_over_steps(Sim& sim, const System& system) {
+  const V p0 = momentum(system);
+  double scale_p = 0;
+  for (std::size_t i = 0; i < system.size(); ++i)
+    scale_p += system.particles().mass[i] * system.particles().velocity[i].norm();
+  for (int k = 0; k < 30; ++k) sim.step();
+  CHECK((momentum(system) - p0).norm() <= 1e-12 * scale_p);
+}
+
+using BladeBody = CoupledBody<RepulsiveForce<double>, Rod>;
+
+FluidParameters<2, double> weightless_fluid() {
   FluidParameters<2, double> fluid;
   fluid.gravity = V::Zero();
-  using Body = CoupledBody<RepulsiveForce<double>, Rod>;
-  Simulation<System, SymplecticVerlet, Body> sim(
-      system, fluid, {}, Body(RepulsiveForce<double>{}, Rod(system, 1, blade_material(), params)));
+  return fluid;
+}
+
+}  // namespace
+
+TEST_CASE("repulsive force on a thin blade: pushes on both faces and conserves momentum", "[coupling][thin]") {
+  System system = blade_between_blocks(3);
+  Simulation<System, SymplecticVerlet, BladeBody> sim(system, weightless_fluid(), {},
+                                                      BladeBody(RepulsiveForce<double>{}, free_blade(system)));
   sim.evaluate_rates(0.0);
   auto& p = system.particles();
   // Both faces: fluid particles on either side of the blade are pushed away from it.
@@ -261,42 +287,18 @@ TEST_CASE("repulsive force on a thin blade: pushes on both faces and conserves m
   CHECK(left < 0);
   CHECK(right > 0);
   CHECK(std::abs(total_x) <= 1e-12 * scale);
-  // Momentum over 30 coupled steps with the sub-cycled blade.
-  const V p0 = momentum(system);
-  double scale_p = 0;
-  for (std::size_t i = 0; i < p.size(); ++i) scale_p += p.mass[i] * p.velocity[i].norm();
-  for (int k = 0; k < 30; ++k) sim.step();
-  CHECK((momentum(system) - p0).norm() <= 1e-12 * scale_p);
+  check_momentum_over_steps(sim, system);
 }
 
 TEST_CASE("repulsive force on a thin blade with the normal dashpot conserves momentum", "[coupling][thin]") {
-  // The free blade between two fluid blocks with random velocities (above), the dashpot on.
-  System system(Domain<2, double>(V(-0.2, -0.2), V(0.3, 0.3)), Tait<double>(1000, 20));
-  const Resolution<double> res{0.005, 1.3};
-  add_fluid_block(system, V(0, 0), V(0.05, 0.06), res, 0.06, 9.81);
-  add_fluid_block(system, V(0.055, 0), V(0.1, 0.06), res, 0.06, 9.81);
-  add_elastic_rod(system, V(0.0525, 0.0), V(0, 1), 0.06, 25, blade_material(), blade_section(), res.h(), 1);
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<double> u(-0.2, 0.2);
-  for (auto& v : system.particles().velocity) v = V(u(rng), u(rng));
-  Rod::Parameters params;
-  params.section = blade_section();
-  params.gravity = V::Zero();
-  // no added inertia (it would make sum m v not the conserved momentum): the blade is 50 times lighter than the
-  // fluid particles, and the dashpot's own step limit (RepulsiveForce::stable_time_step) keeps it stable
-  FluidParameters<2, double> fluid;
-  fluid.gravity = V::Zero();
+  // The blade is 50 times lighter than the fluid particles: the dashpot's own step limit
+  // (RepulsiveForce::stable_time_step) keeps it stable.
+  System system = blade_between_blocks(5);
   RepulsiveForce<double> coupling;
   coupling.normal_damping = 0.5;
-  using Body = CoupledBody<RepulsiveForce<double>, Rod>;
-  Simulation<System, SymplecticVerlet, Body> sim(system, fluid, {},
-                                                 Body(coupling, Rod(system, 1, blade_material(), params)));
-  const V p0 = momentum(system);
-  double scale_p = 0;
-  for (std::size_t i = 0; i < system.size(); ++i)
-    scale_p += system.particles().mass[i] * system.particles().velocity[i].norm();
-  for (int k = 0; k < 30; ++k) sim.step();
-  CHECK((momentum(system) - p0).norm() <= 1e-12 * scale_p);
+  Simulation<System, SymplecticVerlet, BladeBody> sim(system, weightless_fluid(), {},
+                                                      BladeBody(coupling, free_blade(system)));
+  check_momentum_over_steps(sim, system);
 }
 
 TEST_CASE("repulsive force on a thin blade: a jet does not cross it", "[coupling][thin]") {
