@@ -52,10 +52,10 @@ struct RepulsiveForce {
   }
 
   /// The normal dashpot is explicit: the relative normal velocity of a fluid-solid pair relaxes at about
-  /// lambda = beta (c0 / h) (1 + 2 m_f / m_s) (the solid particle meets fluid on both faces of a thin structure; m_s
-  /// includes a rod's added inertia),
-  /// stable for lambda dt < 2. Returns 2 / lambda over the solid's fluid neighbours (the Simulation applies its CFL
-  /// factor to it); without the dashpot the repulsion sets no step of its own here (infinity).
+  /// lambda = beta (c0 / h) (1 + 2 r m_f / m_s), stable for lambda dt < 2. The 2: a node of a thin structure meets
+  /// fluid on both faces; r: the share of a force on m_s that accelerates it (a rod's added inertia lowers it).
+  /// Returns 2 / lambda over the solid's fluid neighbours (the Simulation applies its CFL factor to it); without the
+  /// dashpot the repulsion sets no step of its own here (infinity).
   template <class System, class Solid>
   T stable_time_step(const System& system, const Solid& solid) const {
     T dt = std::numeric_limits<T>::infinity();
