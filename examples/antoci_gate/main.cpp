@@ -195,6 +195,8 @@ int main(int argc, char** argv) try {
   opt.scene.youngs_modulus = cli.get_number("youngs-modulus", 1.2e7, "gate Young's modulus E, Pa");
   opt.scene.smoothing_ratio =
       cli.get_number("smoothing", opt.scene.smoothing_ratio, "smoothing length over spacing h / dp (fluid and gate)");
+  const Scalar cli_normal_damping = cli.get_number(
+      "normal-damping", 0, "repulsive coupling: beta of the normal dashpot, 0-1 (0: the paper's eqs 17-23)");
   const std::string plane = cli.get(
       "plane", "strain", "2D gate: strain (plane strain, a wide plate) | stress (plane stress, free to contract)");
   opt.end_time = cli.get_number("end-time", 0.4, "simulated time, s");
@@ -227,6 +229,7 @@ int main(int argc, char** argv) try {
   // A finer gate (spacing ds = dp / r) has its surface particles ds / 2 inside its face: the first fluid row is
   // (dp + ds) / 2 from them, and a fluid-solid pair uses the averaged smoothing length h_ab = (h_f + h_s) / 2.
   const Scalar fine = (1 + 1 / Scalar(opt.scene.solid_refinement)) / 2;
+  repulsive.normal_damping = cli_normal_damping;
   repulsive.strength = repulsive_strength_for_rest_gap(
       opt.scene.column_height, opt.scene.gravity, opt.scene.fluid_sound_speed, opt.scene.smoothing_ratio * fine, fine);
   const bool tl = solid == "tl";
