@@ -181,21 +181,8 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
   };
   std::vector<Vec<2, T>> tip0;
   for (std::size_t k = 0; k < plant_count; ++k) tip0.push_back(tip_position(system, k));
-  std::vector<std::vector<std::uint32_t>> water_ids(plant_count);
-  std::vector<std::vector<Vec<2, T>>> water0(plant_count);
-  for (std::size_t k = 0; k < plant_count; ++k)
-    for (std::size_t i = 0; i < system.size(); ++i)
-      if (system.particles().kind[i] == Kind::fluid &&
-          (system.particles().position[i] - tip0[k]).norm() < T(1.5) * scene.dp()) {
-        water_ids[k].push_back(system.particles().id[i]);
-        water0[k].push_back(system.particles().position[i]);
-      }
-  auto water_displacement = [&](const System& s, std::size_t k) {
-    Vec<2, T> d = Vec<2, T>::Zero();
-    for (std::size_t j = 0; j < water_ids[k].size(); ++j)
-      d += s.particles().position[s.particles().slot_of_id(water_ids[k][j])] - water0[k][j];
-    return Vec<2, T>(water_ids[k].empty() ? d : Vec<2, T>(d / T(water_ids[k].size())));
-  };
+  std::vector<scenes::FluidTracers<System>> water;
+  for (std::size_t k = 0; k < plant_count; ++k) water.emplace_back(system, tip0[k], T(1.5) * scene.dp());
   std::vector<double> times;
   std::vector<std::vector<double>> tip_dx(plant_count), tip_dz(plant_count), water_dx(plant_count);
   scenes::BladeCrossingCounter<System> crossings(T(1.5) * scene.dp());
@@ -221,7 +208,7 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
             tip_dz[k].push_back(double(d[1]));
           }
           for (std::size_t k = 0; k < plant_count; ++k) {
-            const Vec<2, T> w = water_displacement(sm.system(), k);
+            const Vec<2, T> w = water[k].mean_displacement(sm.system());
             row.push_back(double(w[0]));
             row.push_back(double(w[1]));
             water_dx[k].push_back(double(w[0]));

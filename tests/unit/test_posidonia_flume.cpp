@@ -16,7 +16,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
 #include <numbers>
 #include <vector>
 
@@ -229,6 +228,13 @@ TEST_CASE("rod blades: the load filter keeps the total force and removes the nod
   p.position[p.slot_of_id(p.id[f])] = V(-0.005, 0.09);
   CHECK(counter.update(system, rods) == 0);
   CHECK(counter.total() == 1);
+
+  // the water beside a point: the fluid particles near it at construction, their mean displacement since then
+  const scenes::FluidTracers<System> water(system, V(-0.005, 0.09), 0.005);
+  REQUIRE(water.size() == 1);  // the fluid particle only, not the rod nodes
+  p.position[p.slot_of_id(p.id[f])] = V(0.001, 0.07);
+  CHECK(water.mean_displacement(system).isApprox(V(0.006, -0.02), 1e-12));
+  CHECK_THROWS_WITH(scenes::FluidTracers<System>(system, V(0, 0), 0.0), Catch::Contains("FluidTracers radius"));
 }
 
 namespace {
@@ -260,20 +266,11 @@ StillWaterBlade still_water_blade(double beta, double end_time) {
   scenes::BladeCrossingCounter<System> counter(1.5 * s.dp());
   StillWaterBlade out;
   out.length = s.blade_length();
-  std::vector<std::uint32_t> water;  // tracers: the fluid particles within 1.5 dp of the tip
-  std::vector<V> water0;
-  for (std::size_t i = 0; i < system.size(); ++i)
-    if (system.particles().kind[i] == Kind::fluid && (system.particles().position[i] - tip0).norm() < 1.5 * s.dp()) {
-      water.push_back(system.particles().id[i]);
-      water0.push_back(system.particles().position[i]);
-    }
+  const scenes::FluidTracers<System> water(system, tip0, 1.5 * s.dp());  // the fluid within 1.5 dp of the tip
   REQUIRE(water.size() >= 4);
   sim.run(end_time, [&](auto& sm) {
     const V d = sm.template model<1>().rod(0).tip_position() - tip0;
-    const auto& p = sm.system().particles();
-    double water_dx = 0;
-    for (std::size_t k = 0; k < water.size(); ++k) water_dx += p.position[p.slot_of_id(water[k])][0] - water0[k][0];
-    out.max_abs_water_dx = std::max(out.max_abs_water_dx, std::abs(water_dx) / double(water.size()));
+    out.max_abs_water_dx = std::max(out.max_abs_water_dx, std::abs(water.mean_displacement(sm.system())[0]));
     out.max_abs_dx = std::max(out.max_abs_dx, std::abs(d[0]));
     out.min_dz = std::min(out.min_dz, d[1]);
     if (sm.step_count() % 20 == 0) counter.update(sm.system(), sm.template model<1>());

@@ -349,4 +349,37 @@ class BladeCrossingCounter {
   std::size_t total_{0};
 };
 
+/// The water beside a point (a blade's tip): the fluid particles within `radius` of `centre` when constructed,
+/// followed by id. mean_displacement() is their mean displacement since then: a passive blade cannot move further
+/// than the water around it.
+template <class System>
+class FluidTracers {
+ public:
+  using T = typename System::scalar_type;
+  using Vector = Vec<System::dimension, T>;
+
+  FluidTracers(const System& system, const Vector& centre, T radius) {
+    require_positive("FluidTracers radius (m)", radius);
+    const auto& p = system.particles();
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (p.kind[i] == Kind::fluid && (p.position[i] - centre).norm() < radius) {
+        ids_.push_back(p.id[i]);
+        start_.push_back(p.position[i]);
+      }
+  }
+
+  std::size_t size() const noexcept { return ids_.size(); }
+  /// Mean displacement of the tracers from their positions at construction (zero without tracers), m.
+  Vector mean_displacement(const System& system) const {
+    const auto& p = system.particles();
+    Vector d = Vector::Zero();
+    for (std::size_t k = 0; k < ids_.size(); ++k) d += p.position[p.slot_of_id(ids_[k])] - start_[k];
+    return ids_.empty() ? d : Vector(d / T(ids_.size()));
+  }
+
+ private:
+  std::vector<std::uint32_t> ids_;
+  std::vector<Vector> start_;
+};
+
 }  // namespace sphfsi::scenes
