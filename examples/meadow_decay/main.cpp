@@ -8,8 +8,11 @@
 // (t = 0.1 mm, rho = 920 kg/m^3, E = 12 EI / (b t^3) with EI = 7.5e-8 N m^2, b = 3 mm; l = 0.13 m on a 0.01 m
 // sheath modelled as the rigid, clamped lowest part) every dx_b = 1 / (N b) = 0.0463 m (N = 7200 blades/m^2: the
 // frontal area per bed area N b l of the real meadow), each one elastic rod with the real bending stiffness and mass
-// per unit width, pushed on both faces by the repulsive force. The fluid spacing is dx_b / m (m particles between
-// blades; m = 3: h/dp = 10.4), so every blade stands on a lattice line between two fluid columns.
+// per unit width. By default (--coupling drag) each blade exchanges its Morison drag with the fluid, which passes
+// through it as the water passes between the blades of the 3D meadow (coupling/blade_drag.hpp); --coupling repulsive
+// pushes the fluid on both faces with the repulsive force instead (a 2D wall, up to the leak of the SPH sums through
+// it; docs/meadow.md). The fluid spacing is dx_b / m (m particles between blades; m = 3: h/dp = 10.4), so every
+// blade stands on a lattice line between two fluid columns.
 //
 // The same flume is run without the meadow (equal resolution): the empty flume's own decay and generation deficit
 // (docs/flume.md) are divided out in the "empty-normalised" H/H0. H0 is the height at the meadow's leading edge of
@@ -51,7 +54,12 @@ using namespace sphfsi;
 using T = double;
 using V = Vec<2, T>;
 using System = ParticleSystem<2, T, WendlandC2<2>, Tait<T>>;
-using Blades = scenes::RodBlades<System>;
+using RepulsiveBlades = scenes::RodBlades<System>;
+using DragBlades = scenes::RodBlades<System, BladeDrag<T>>;
+
+/// Which flume a run simulates: no meadow, or the meadow with the repulsive (impermeable) or the drag (porous)
+/// blade coupling.
+enum class Run { empty, repulsive, drag };
 
 /// The experiment (Luhar et al. 2017, H1) and the model's choices.
 struct Options {
@@ -73,6 +81,10 @@ struct Options {
   // holds the whole wave pressure difference; see docs/meadow.md), and the weak repulsion that stops the fluid.
   bool visibility = false;
   std::string repulsion = "stop";  // blade repulsion strength: stop | hydrostatic
+  // blade coupling: drag (porous blades exchange their Morison drag with the fluid, coupling/blade_drag.hpp) |
+  // repulsive (the repulsive force of eqs 17-23; the fluid leaks through it in the SPH sums, docs/meadow.md)
+  std::string coupling = "drag";
+  T blade_cd = 1.95, blade_cf = 0, added_mass_coefficient = 1;  // drag coupling: C_D, C_f, C_M
   std::filesystem::path out = "out/meadow_decay", empty_from, meadow_from;
 };
 
@@ -135,8 +147,10 @@ struct RunResult {
   std::string failure;
 };
 
-template <bool WithMeadow>
+template <Run Kind>
 RunResult run_case(const Options& o, const std::filesystem::path& dir) {
+  constexpr bool WithMeadow = Kind != Run::empty;
+  using Blades = std::conditional_t<Kind == Run::drag, DragBlades, RepulsiveBlades>;
   using Solver = std::conditional_t<WithMeadow, Simulation<System, SymplecticVerlet, waves::DampingZone<T>, Blades>,
                                     Simulation<System, SymplecticVerlet, waves::DampingZone<T>>>;
   const auto g = flume(o);
@@ -149,7 +163,16 @@ RunResult run_case(const Options& o, const std::filesystem::path& dir) {
   const waves::Wavemaker<T> maker(g.wave);
   const auto wave = maker.wave();
   const auto make_solver = [&]() {
-    if constexpr (WithMeadow) {
+    if constexpr (Kind == Run::drag) {
+      scenes::DragBladeCoupling<T> how;
+      how.coupling.drag_coefficient = o.blade_cd;
+      how.coupling.friction_coefficient = o.blade_cf;
+      how.blade_width = o.blade_width;
+      how.added_mass_coefficient = o.added_mass_coefficient;
+      return Solver(system, fluid, {}, g.damping_zone(),
+                    scenes::add_drag_blades(system, bases, T(0), blade(o), dp, g.smoothing_ratio * dp,
+                                            layout.first_free_body, how));
+    } else if constexpr (WithMeadow) {
       scenes::RodBladeCoupling<T> how;
       how.added_mass_ratio = o.added_mass;
       how.load_smoothing_passes = o.load_smoothing;
@@ -304,9 +327,17 @@ int main(int argc, char** argv) try {
   o.repulsion = cli.get("repulsion", "stop",
                         "blade repulsion strength: stop (weakest that stops the fluid at 3 x the orbital velocity) | "
                         "hydrostatic (each face holds its side's hydrostatic load: for --visibility on)");
+  o.coupling = cli.get("coupling", "drag",
+                       "blade coupling: drag (porous blades exchange their Morison drag with the fluid: the 2D "
+                       "stand-in for a 3D canopy) | repulsive (eqs 17-23: impermeable up to the SPH sums' leak)");
+  o.blade_cd = cli.get_number("blade-cd", o.blade_cd, "drag coupling: C_D on the blade-normal relative velocity");
+  o.blade_cf = cli.get_number("blade-cf", o.blade_cf, "drag coupling: C_f on the tangential relative velocity");
+  o.added_mass_coefficient = cli.get_number(
+      "added-mass-coefficient", o.added_mass_coefficient,
+      "drag coupling: C_M of the rods' added inertia C_M rho_w pi b / 4 (--added-mass is for the repulsive one)");
   o.check = cli.get_switch("check", false,
-                           "on: exit status 4 if a fluid particle crossed a blade or a blade tip fell below half its "
-                           "length (regression guard)");
+                           "on: exit status 4 if a blade tip fell below half its length or, with --coupling "
+                           "repulsive, a fluid particle crossed a blade (regression guard)");
   o.out = cli.get("output", "out/meadow_decay", "output folder");
   o.empty_from = cli.get("empty-from", "", "with --runs meadow: take the empty flume's heights from DIR/empty");
   o.meadow_from = cli.get("meadow-from", "", "analyse DIR/meadow/wave_heights.csv of an earlier run (no meadow run)");
@@ -317,6 +348,8 @@ int main(int argc, char** argv) try {
   require_in_range("--gauge-spacing (m)", o.gauge_spacing, T(0.02), T(2));
   if (runs != "both" && runs != "meadow" && runs != "empty")
     throw InputError(fmt::format("--runs '{}': valid are both, meadow, empty", runs));
+  if (o.coupling != "drag" && o.coupling != "repulsive")
+    throw InputError(fmt::format("--coupling '{}': valid are drag, repulsive", o.coupling));
   if (o.repulsion != "hydrostatic" && o.repulsion != "stop")
     throw InputError(fmt::format("--repulsion '{}': valid are hydrostatic, stop", o.repulsion));
   o.run_meadow = runs != "empty" && o.meadow_from.empty();
@@ -339,8 +372,9 @@ int main(int argc, char** argv) try {
       b.bending_stiffness_per_width(), b.node_count(g.dp()));
 
   RunResult with, without;
-  if (o.run_meadow) with = run_case<true>(o, o.out / "meadow");
-  if (o.run_empty) without = run_case<false>(o, o.out / "empty");
+  if (o.run_meadow)
+    with = o.coupling == "drag" ? run_case<Run::drag>(o, o.out / "meadow") : run_case<Run::repulsive>(o, o.out / "meadow");
+  if (o.run_empty) without = run_case<Run::empty>(o, o.out / "empty");
   const auto gx = gauge_positions(o);
   auto heights_from = [&](const std::filesystem::path& file, const char* flag) {
     const auto table = io::read_csv(file);
@@ -492,12 +526,14 @@ int main(int argc, char** argv) try {
   if (failed) return 3;
   if (o.check && o.run_meadow) {
     const T half = T(0.5) * (o.blade_length + o.sheath);
-    if (with.crossings > 0 || !(with.lowest_tip >= half)) {
-      fmt::print(stderr, "check failed: {} crossings (valid: 0), lowest tip {:.4f} m (valid: >= {:.4f} m)\n",
-                 with.crossings, with.lowest_tip, half);
+    // porous (drag) blades let the fluid through by design: only the repulsive coupling must have no crossing
+    const bool impermeable = o.coupling == "repulsive";
+    if ((impermeable && with.crossings > 0) || !(with.lowest_tip >= half)) {
+      fmt::print(stderr, "check failed: {} crossings (valid: {}), lowest tip {:.4f} m (valid: >= {:.4f} m)\n",
+                 with.crossings, impermeable ? "0" : "any, porous blades", with.lowest_tip, half);
       return 4;
     }
-    fmt::print("check passed: no crossing, every tip above {:.4f} m\n", half);
+    fmt::print("check passed: {}every tip above {:.4f} m\n", impermeable ? "no crossing, " : "", half);
   }
   return 0;
 } catch (const std::exception& e) {

@@ -1,5 +1,6 @@
 // Tests of the three FSI coupling policies: each conserves the linear momentum of the fluid-solid pair to round-off.
 #include <sphfsi/core/particle_system.hpp>
+#include <sphfsi/coupling/blade_drag.hpp>
 #include <sphfsi/coupling/coupled_body.hpp>
 #include <sphfsi/coupling/interface_pressure.hpp>
 #include <sphfsi/coupling/repulsive_force.hpp>
@@ -333,4 +334,119 @@ TEST_CASE("repulsive force on a thin blade: a jet does not cross it", "[coupling
   INFO("closest approach " << closest << " m, steps " << sim.step_count());
   CHECK(crossed == 0);
   CHECK(closest > 0.1 * res.dp);  // the jet is stopped well before the blade line
+}
+
+// ---- porous blades: the Morison drag coupling (coupling/blade_drag.hpp) ----
+
+namespace {
+
+using DragBody = CoupledBody<BladeDrag<double>, Rod>;
+
+// A straight free blade of length 0.04 m at 30 degrees from the vertical, from (0.05, 0.03), inside (or, with
+// `top` below its tip, sticking out of) a weightless fluid block of width 0.1 m.
+System blade_in_block(double top) {
+  System system(Domain<2, double>(V(-0.2, -0.2), V(0.3, 0.3)), Tait<double>(1000, 20));
+  const Resolution<double> res{0.005, 1.3};
+  add_fluid_block(system, V(0, 0), V(0.1, top), res, top, 0.0);
+  add_elastic_rod(system, V(0.05, 0.03), V(0.5, std::sqrt(3.0) / 2), 0.04, 17, blade_material(), blade_section(),
+                  res.h(), 1);
+  return system;
+}
+
+// Evaluates the rates (neighbours, the rod's normals) and returns the drag's accelerations alone.
+void drag_only(System& system, const BladeDrag<double>& drag) {
+  Simulation<System, SymplecticVerlet, DragBody> sim(system, weightless_fluid(), {}, DragBody(drag, free_blade(system)));
+  sim.evaluate_rates(0.0);
+  auto& p = system.particles();
+  for (std::size_t i = 0; i < p.size(); ++i) p.acceleration[i] = V::Zero();
+  drag.apply(system, sim.template model<0>().solid(), 0.0);
+}
+
+}  // namespace
+
+TEST_CASE("blade drag: the Morison force of a uniform stream on an inclined blade, momentum, dissipation",
+          "[coupling][thin]") {
+  BladeDrag<double> drag;
+  drag.friction_coefficient = 0.05;
+  const double U = 0.2, l = 0.04, rho = 1000, angle = std::numbers::pi / 6;  // blade 30 degrees from the vertical
+  System system = blade_in_block(0.1);
+  auto& p = system.particles();
+  for (std::size_t i = 0; i < p.size(); ++i) p.velocity[i] = p.kind[i] == Kind::fluid ? V(U, 0) : V::Zero();
+  drag_only(system, drag);
+  V on_blade = V::Zero(), total = V::Zero();
+  double scale = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    total += p.mass[i] * p.acceleration[i];
+    scale += p.mass[i] * p.acceleration[i].norm();
+    if (p.kind[i] == Kind::solid) on_blade += p.mass[i] * p.acceleration[i];
+  }
+  // Shepard interpolation of a uniform velocity is exact, and the nodes' shares ds_k add up to l: the total is the
+  // Morison force of the whole blade, (1/2) rho l (C_D u_n^2 n + C_f u_t^2 t).
+  const V tangent(std::sin(angle), std::cos(angle)), normal(std::cos(angle), -std::sin(angle));
+  const double un = U * std::cos(angle), ut = U * std::sin(angle);
+  const V expected = 0.5 * rho * l * (drag.drag_coefficient * un * un * normal + drag.friction_coefficient * ut * ut * tangent);
+  INFO("force on the blade (" << on_blade.transpose() << ") N/m, Morison (" << expected.transpose() << ")");
+  CHECK((on_blade - expected).norm() <= 1e-12 * expected.norm());
+  CHECK(total.norm() <= 1e-12 * scale);  // the fluid receives exactly the opposite
+
+  // Random velocities of fluid and blade: momentum to round-off, and the coupling only dissipates.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-0.3, 0.3);
+  for (int trial = 0; trial < 20; ++trial) {
+    for (auto& v : p.velocity) v = V(u(rng), u(rng));
+    drag_only(system, drag);
+    V sum = V::Zero();
+    double power = 0, magnitude = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      sum += p.mass[i] * p.acceleration[i];
+      power += p.mass[i] * p.acceleration[i].dot(p.velocity[i]);
+      magnitude += std::abs(p.mass[i] * p.acceleration[i].dot(p.velocity[i]));
+      scale = std::max(scale, p.mass[i] * p.acceleration[i].norm());
+    }
+    CHECK(sum.norm() <= 1e-12 * magnitude / 0.3);
+    CHECK(power <= 1e-12 * magnitude);
+    CHECK(power < 0);
+  }
+}
+
+TEST_CASE("blade drag: nodes above the free surface exchange nothing; 30 coupled steps keep momentum",
+          "[coupling][thin]") {
+  System system = blade_in_block(0.045);  // the blade reaches z = 0.03 + 0.04 cos 30 = 0.065 m
+  auto& p = system.particles();
+  for (std::size_t i = 0; i < p.size(); ++i) p.velocity[i] = p.kind[i] == Kind::fluid ? V(0.2, 0.05) : V::Zero();
+  drag_only(system, BladeDrag<double>{});
+  const double reach = 2 * 1.3 * 0.005;  // the cubic spline's support radius
+  int dry = 0, wet = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (p.kind[i] != Kind::solid) continue;
+    if (p.position[i][1] > 0.045 - 0.0025 + reach) {  // beyond the support of the top fluid row
+      ++dry;
+      CHECK(p.acceleration[i].norm() == 0.0);
+    } else if (p.position[i][1] < 0.04) {
+      ++wet;
+      CHECK(p.acceleration[i][0] > 0);  // pushed downstream
+    }
+  }
+  CHECK(dry >= 3);
+  CHECK(wet >= 3);
+
+  System moving = blade_in_block(0.1);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-0.2, 0.2);
+  for (auto& v : moving.particles().velocity) v = V(u(rng), u(rng));
+  Simulation<System, SymplecticVerlet, DragBody> sim(moving, weightless_fluid(), {},
+                                                     DragBody(BladeDrag<double>{}, free_blade(moving)));
+  check_momentum_over_steps(sim, moving);
+}
+
+TEST_CASE("blade drag: bad coefficients are rejected with the valid range", "[coupling][thin]") {
+  BladeDrag<double> drag;
+  drag.drag_coefficient = -1;
+  CHECK_THROWS_WITH(drag.validate(), Catch::Contains("BladeDrag::drag_coefficient") && Catch::Contains("[0, 10]"));
+  drag.drag_coefficient = 1.95;
+  drag.friction_coefficient = 2;
+  CHECK_THROWS_WITH(drag.validate(), Catch::Contains("BladeDrag::friction_coefficient"));
+  drag.friction_coefficient = 0;
+  drag.fluid_density = -1;
+  CHECK_THROWS_WITH(drag.validate(), Catch::Contains("BladeDrag::fluid_density"));
 }

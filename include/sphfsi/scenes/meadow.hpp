@@ -40,6 +40,7 @@
 
 #include <sphfsi/core/error.hpp>
 #include <sphfsi/core/particle_system.hpp>
+#include <sphfsi/coupling/blade_drag.hpp>
 #include <sphfsi/coupling/coupled_body.hpp>
 #include <sphfsi/coupling/repulsive_force.hpp>
 #include <sphfsi/solid/elastic_rod.hpp>
@@ -144,14 +145,42 @@ struct RodBladeCoupling {
   }
 };
 
-/// The blades of a flume: one coupled elastic rod per blade, one ParticleModel.
-template <class System>
+/// How porous blades (a 2D stand-in for a 3D canopy: coupling/blade_drag.hpp) meet the fluid and the bed.
+template <Real T>
+struct DragBladeCoupling {
+  BladeDrag<T> coupling{};  ///< Morison drag on the blade-normal (C_D) and tangential (C_f) relative velocity
+  /// Width b of one real blade, m: the rod's added inertia is the physical C_M rho_w pi b / 4 per unit length and
+  /// width (a flat plate of width b moving normal to itself; Luhar & Nepf 2016), > 0.
+  T blade_width{T(3e-3)};
+  T added_mass_coefficient{T(1)};  ///< C_M, [0, 2]
+  T ambient_density{T(1000)};      ///< rho_w for the blade's buoyancy and added inertia, kg/m^3
+  T gravity{T(9.81)};              ///< m/s^2
+  T contact_gap_ratio{T(1)};       ///< the bed contact plane's gap over dp
+  T stretch_limit{T(1.5)};         ///< BlowUpError above this edge stretch
+  int load_smoothing_passes{0};    ///< passes of RodBlades' load filter (the interpolated drag is smooth: none)
+
+  void validate() const {
+    coupling.validate();
+    require_positive("DragBladeCoupling::blade_width (b, m)", blade_width);
+    require_in_range("DragBladeCoupling::added_mass_coefficient (C_M)", added_mass_coefficient, T(0), T(2));
+    require_positive("DragBladeCoupling::ambient_density (kg/m^3)", ambient_density);
+    require_non_negative("DragBladeCoupling::gravity (m/s^2)", gravity);
+    require_positive("DragBladeCoupling::contact_gap_ratio", contact_gap_ratio);
+    require_in_range("DragBladeCoupling::stretch_limit", stretch_limit, T(1), T(10));
+  }
+  /// Added inertia per unit length and width, C_M rho_w pi b / 4, kg/m^2.
+  T added_mass_per_area() const { return added_mass_coefficient * ambient_density * T(3.14159265358979323846) * blade_width / T(4); }
+};
+
+/// The blades of a flume: one coupled elastic rod per blade, one ParticleModel. Coupling: RepulsiveForce (a blade
+/// the fluid cannot cross, add_rod_blades) or BladeDrag (a porous stand-in for a 3D canopy, add_drag_blades).
+template <class System, class Coupling = RepulsiveForce<typename System::scalar_type>>
 class RodBlades {
  public:
   using T = typename System::scalar_type;
   using Vector = Vec<2, T>;
   using Rod = ElasticRod<System>;
-  using Blade = CoupledBody<RepulsiveForce<T>, Rod>;
+  using Blade = CoupledBody<Coupling, Rod>;
 
   explicit RodBlades(std::vector<Blade> blades, int load_smoothing_passes = 0)
       : blades_(std::move(blades)), passes_(load_smoothing_passes) {
@@ -240,17 +269,68 @@ class RodBlades {
   std::vector<Vector> force_, next_;
 };
 
+namespace detail {
+/// The rods of blades standing at base_x on the bed z = bed (bodies first_body, first_body + 1, ...; nodes every
+/// about node_spacing_ratio dp), clamped over clamped_height (at least the base node and its tangent), with the bed
+/// as contact plane one gap above it.
+template <class System>
+std::vector<ElasticRod<System>> blade_rods(System& system, const std::vector<typename System::scalar_type>& base_x,
+                                           typename System::scalar_type bed,
+                                           const ThinBlade<typename System::scalar_type>& blade,
+                                           typename System::scalar_type dp,
+                                           typename System::scalar_type smoothing_length, std::int32_t first_body,
+                                           const typename ElasticRod<System>::Parameters& params,
+                                           typename System::scalar_type contact_gap) {
+  using T = typename System::scalar_type;
+  using V = Vec<2, T>;
+  using Rod = ElasticRod<System>;
+  if (base_x.empty()) throw InputError("add_rod_blades: no blade positions given (valid: at least one)");
+  const int nodes = blade.node_count(dp);
+  for (std::size_t k = 0; k < base_x.size(); ++k)
+    add_elastic_rod(system, V(base_x[k], bed), V(0, 1), blade.length, nodes, blade.material(),
+                    RodSection<T>{.thickness = blade.thickness, .width = T(1)}, smoothing_length,
+                    first_body + std::int32_t(k));
+  std::vector<Rod> rods;
+  rods.reserve(base_x.size());
+  const T top_of_clamp = bed + blade.clamped_height + T(1e-6) * dp;
+  for (std::size_t k = 0; k < base_x.size(); ++k) {
+    Rod rod(system, first_body + std::int32_t(k), blade.material(), params);
+    rod.clamp_base();
+    if (blade.clamped_height > T(0)) rod.clamp_where([&](const V& x) { return x[1] <= top_of_clamp; });
+    rod.set_contact_plane(V(0, bed), V(0, 1), contact_gap);
+    rods.push_back(std::move(rod));
+  }
+  return rods;
+}
+
+/// Rod parameters of a full-width 2D blade (section per unit width) with buoyancy and added inertia.
+template <class System>
+typename ElasticRod<System>::Parameters blade_rod_parameters(const ThinBlade<typename System::scalar_type>& blade,
+                                                             typename System::scalar_type gravity,
+                                                             typename System::scalar_type ambient_density,
+                                                             typename System::scalar_type stretch_limit,
+                                                             typename System::scalar_type added_mass_per_area) {
+  using T = typename System::scalar_type;
+  typename ElasticRod<System>::Parameters params;
+  params.section = {.thickness = blade.thickness, .width = T(1)};  // per unit width (full-width 2D blade)
+  params.gravity = Vec<2, T>(0, -gravity);
+  params.ambient_density = ambient_density;
+  params.stretch_limit = stretch_limit;
+  params.added_mass_per_area = added_mass_per_area;
+  return params;
+}
+}  // namespace detail
+
 /// Adds one blade per base position x (m, on the bed z = bed) to `system` as solid bodies first_body, first_body
 /// + 1, ... (rod nodes every about node_spacing_ratio dp), and returns the coupled rods, clamped over
-/// clamped_height (at least the base node and its tangent), with the bed as contact plane.
+/// clamped_height (at least the base node and its tangent), with the bed as contact plane. The repulsive coupling:
+/// the fluid does not cross the blades.
 template <class System>
 RodBlades<System> add_rod_blades(System& system, const std::vector<typename System::scalar_type>& base_x,
                                  typename System::scalar_type bed, const ThinBlade<typename System::scalar_type>& blade,
                                  typename System::scalar_type dp, typename System::scalar_type smoothing_length,
                                  std::int32_t first_body, const RodBladeCoupling<typename System::scalar_type>& how) {
   using T = typename System::scalar_type;
-  using V = Vec<2, T>;
-  using Rod = ElasticRod<System>;
   blade.validate();
   require_positive("add_rod_blades: dp (m)", dp);
   require_positive("add_rod_blades: ambient density (kg/m^3)", how.ambient_density);
@@ -263,29 +343,36 @@ RodBlades<System> add_rod_blades(System& system, const std::vector<typename Syst
     coupling.strength = repulsion_strength_to_stop(how.stopping_speed, c0);
   }
   require_non_negative("add_rod_blades: added_mass_ratio (m_a / (rho_w dp))", how.added_mass_ratio);
-  if (base_x.empty()) throw InputError("add_rod_blades: no blade positions given (valid: at least one)");
-  const int nodes = blade.node_count(dp);
-  for (std::size_t k = 0; k < base_x.size(); ++k)
-    add_elastic_rod(system, V(base_x[k], bed), V(0, 1), blade.length, nodes, blade.material(),
-                    RodSection<T>{.thickness = blade.thickness, .width = T(1)}, smoothing_length,
-                    first_body + std::int32_t(k));
-  typename Rod::Parameters params;
-  params.section = {.thickness = blade.thickness, .width = T(1)};  // per unit width (full-width 2D blade)
-  params.gravity = V(0, -how.gravity);
-  params.ambient_density = how.ambient_density;
-  params.stretch_limit = how.stretch_limit;
-  params.added_mass_per_area = how.added_mass_ratio * how.ambient_density * dp;
+  const auto params = detail::blade_rod_parameters<System>(blade, how.gravity, how.ambient_density, how.stretch_limit,
+                                                           how.added_mass_ratio * how.ambient_density * dp);
+  auto rods = detail::blade_rods(system, base_x, bed, blade, dp, smoothing_length, first_body, params,
+                                 how.contact_gap_ratio * dp);
   std::vector<typename RodBlades<System>::Blade> blades;
-  blades.reserve(base_x.size());
-  const T top_of_clamp = bed + blade.clamped_height + T(1e-6) * dp;
-  for (std::size_t k = 0; k < base_x.size(); ++k) {
-    Rod rod(system, first_body + std::int32_t(k), blade.material(), params);
-    rod.clamp_base();
-    if (blade.clamped_height > T(0)) rod.clamp_where([&](const V& x) { return x[1] <= top_of_clamp; });
-    rod.set_contact_plane(V(0, bed), V(0, 1), how.contact_gap_ratio * dp);
-    blades.emplace_back(coupling, std::move(rod));
-  }
+  blades.reserve(rods.size());
+  for (auto& rod : rods) blades.emplace_back(coupling, std::move(rod));
   return RodBlades<System>(std::move(blades), how.load_smoothing_passes);
+}
+
+/// The same blades with the porous Morison-drag coupling (coupling/blade_drag.hpp): the fluid passes through them
+/// and each exchanges its drag with it; the rods carry the physical added inertia C_M rho_w pi b / 4.
+template <class System>
+RodBlades<System, BladeDrag<typename System::scalar_type>> add_drag_blades(
+    System& system, const std::vector<typename System::scalar_type>& base_x, typename System::scalar_type bed,
+    const ThinBlade<typename System::scalar_type>& blade, typename System::scalar_type dp,
+    typename System::scalar_type smoothing_length, std::int32_t first_body,
+    const DragBladeCoupling<typename System::scalar_type>& how) {
+  using Blades = RodBlades<System, BladeDrag<typename System::scalar_type>>;
+  blade.validate();
+  require_positive("add_drag_blades: dp (m)", dp);
+  how.validate();
+  const auto params = detail::blade_rod_parameters<System>(blade, how.gravity, how.ambient_density, how.stretch_limit,
+                                                           how.added_mass_per_area());
+  auto rods = detail::blade_rods(system, base_x, bed, blade, dp, smoothing_length, first_body, params,
+                                 how.contact_gap_ratio * dp);
+  std::vector<typename Blades::Blade> blades;
+  blades.reserve(rods.size());
+  for (auto& rod : rods) blades.emplace_back(how.coupling, std::move(rod));
+  return Blades(std::move(blades), how.load_smoothing_passes);
 }
 
 /// Counts fluid particles that crossed a blade between two calls: a fluid particle beside a blade (its nearest
@@ -301,7 +388,8 @@ class BladeCrossingCounter {
   explicit BladeCrossingCounter(T reach) : reach_(reach) { require_positive("BladeCrossingCounter reach (m)", reach); }
 
   /// Updates the sides from the current state; returns the crossings found since the last call.
-  std::size_t update(const System& system, const RodBlades<System>& blades) {
+  template <class Blades>
+  std::size_t update(const System& system, const Blades& blades) {
     const auto& p = system.particles();
     std::unordered_map<std::uint64_t, signed char> now;
     std::size_t crossed = 0;
