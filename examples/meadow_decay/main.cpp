@@ -373,7 +373,8 @@ int main(int argc, char** argv) try {
 
   RunResult with, without;
   if (o.run_meadow)
-    with = o.coupling == "drag" ? run_case<Run::drag>(o, o.out / "meadow") : run_case<Run::repulsive>(o, o.out / "meadow");
+    with =
+        o.coupling == "drag" ? run_case<Run::drag>(o, o.out / "meadow") : run_case<Run::repulsive>(o, o.out / "meadow");
   if (o.run_empty) without = run_case<Run::empty>(o, o.out / "empty");
   const auto gx = gauge_positions(o);
   auto heights_from = [&](const std::filesystem::path& file, const char* flag) {

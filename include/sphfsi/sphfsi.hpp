@@ -13,6 +13,7 @@
 #include <sphfsi/core/particle_set.hpp>
 #include <sphfsi/core/particle_system.hpp>
 #include <sphfsi/core/types.hpp>
+#include <sphfsi/coupling/blade_drag.hpp>
 #include <sphfsi/coupling/concepts.hpp>
 #include <sphfsi/coupling/coupled_body.hpp>
 #include <sphfsi/coupling/interface_pressure.hpp>

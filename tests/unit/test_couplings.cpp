@@ -355,7 +355,8 @@ System blade_in_block(double top) {
 
 // Evaluates the rates (neighbours, the rod's normals) and returns the drag's accelerations alone.
 void drag_only(System& system, const BladeDrag<double>& drag) {
-  Simulation<System, SymplecticVerlet, DragBody> sim(system, weightless_fluid(), {}, DragBody(drag, free_blade(system)));
+  Simulation<System, SymplecticVerlet, DragBody> sim(system, weightless_fluid(), {},
+                                                     DragBody(drag, free_blade(system)));
   sim.evaluate_rates(0.0);
   auto& p = system.particles();
   for (std::size_t i = 0; i < p.size(); ++i) p.acceleration[i] = V::Zero();
@@ -384,7 +385,8 @@ TEST_CASE("blade drag: the Morison force of a uniform stream on an inclined blad
   // Morison force of the whole blade, (1/2) rho l (C_D u_n^2 n + C_f u_t^2 t).
   const V tangent(std::sin(angle), std::cos(angle)), normal(std::cos(angle), -std::sin(angle));
   const double un = U * std::cos(angle), ut = U * std::sin(angle);
-  const V expected = 0.5 * rho * l * (drag.drag_coefficient * un * un * normal + drag.friction_coefficient * ut * ut * tangent);
+  const V expected =
+      0.5 * rho * l * (drag.drag_coefficient * un * un * normal + drag.friction_coefficient * ut * ut * tangent);
   INFO("force on the blade (" << on_blade.transpose() << ") N/m, Morison (" << expected.transpose() << ")");
   CHECK((on_blade - expected).norm() <= 1e-12 * expected.norm());
   CHECK(total.norm() <= 1e-12 * scale);  // the fluid receives exactly the opposite

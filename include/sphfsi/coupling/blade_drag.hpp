@@ -89,8 +89,9 @@ struct BladeDrag {
   template <class System, class Solid>
   void apply(System& system, const Solid& solid, T /*time*/) const {
     static_assert(System::dimension == 2, "BladeDrag: 2D thin structures only");
-    static_assert(requires { requires Solid::thin_structure; },
-                  "BladeDrag needs a thin structure (one line of nodes that publish their normals, e.g. ElasticRod)");
+    static_assert(
+        requires { requires Solid::thin_structure; },
+        "BladeDrag needs a thin structure (one line of nodes that publish their normals, e.g. ElasticRod)");
     auto& p = system.particles();
     const T rho = density(system);
     const auto& ids = solid.particle_ids();

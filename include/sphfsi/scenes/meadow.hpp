@@ -1,6 +1,7 @@
 // sphfsi: real thin blades (seagrass) standing in a 2D flume: each blade one elastic rod (solid/elastic_rod.hpp)
 // with its real thickness, density and bending stiffness, clamped in the bed and coupled to the fluid by the
-// two-faced repulsive force (coupling/repulsive_force.hpp, the reference paper's eqs 17-23). Used by
+// two-faced repulsive force (coupling/repulsive_force.hpp, the reference paper's eqs 17-23) or, as porous blades,
+// by their Morison drag (coupling/blade_drag.hpp). Used by
 // examples/posidonia_flume (--blade rod) and examples/meadow_decay.
 //
 // The 2D equivalent of a meadow. A 3D meadow of N blades per m^2, each of width b and length l, presents the
@@ -36,6 +37,12 @@
 // rigid part of height `clamped_height` (the sheath of a seagrass shoot); the bed is a contact plane (a blade that
 // folds over rests one gap above it). RodBlades<System> holds one CoupledBody<RepulsiveForce, ElasticRod> per
 // blade and is one ParticleModel for the Simulation.
+//
+// Porous blades (add_drag_blades, RodBlades<System, BladeDrag<T>>): in the 3D meadow the water flows between the
+// blades, so a 2D stand-in for a row of them should not block the 2D fluid. With coupling/blade_drag.hpp each node
+// exchanges its Morison drag with the fluid around it, the fluid passes through, and the rods carry the physical
+// added inertia C_M rho_w pi b / 4 of a plate of width b (no numerical added inertia and no repulsion are needed:
+// nothing pushes on the blade but its drag). examples/meadow_decay uses them by default (docs/meadow.md).
 #pragma once
 
 #include <sphfsi/core/error.hpp>
@@ -169,7 +176,9 @@ struct DragBladeCoupling {
     require_in_range("DragBladeCoupling::stretch_limit", stretch_limit, T(1), T(10));
   }
   /// Added inertia per unit length and width, C_M rho_w pi b / 4, kg/m^2.
-  T added_mass_per_area() const { return added_mass_coefficient * ambient_density * T(3.14159265358979323846) * blade_width / T(4); }
+  T added_mass_per_area() const {
+    return added_mass_coefficient * ambient_density * T(3.14159265358979323846) * blade_width / T(4);
+  }
 };
 
 /// The blades of a flume: one coupled elastic rod per blade, one ParticleModel. Coupling: RepulsiveForce (a blade
