@@ -17,6 +17,7 @@
 // Writes <output>/summary.csv (one row per case), <output>/case_<Ca>.csv (drag and tip position vs time) and
 // <output>/effective_length.png (plot.py).
 #include <sphfsi/core/particle_system.hpp>
+#include <sphfsi/coupling/blade_drag.hpp>
 #include <sphfsi/coupling/coupled_body.hpp>
 #include <sphfsi/coupling/repulsive_force.hpp>
 #include <sphfsi/eos/tait.hpp>
@@ -39,6 +40,7 @@
 #include <numbers>
 #include <sstream>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 using namespace sphfsi;
@@ -46,8 +48,6 @@ using T = double;
 using V = Vec<2, T>;
 using System = ParticleSystem<2, T, WendlandC2<2>, Tait<T>>;
 using Rod = ElasticRod<System>;
-using Blade = CoupledBody<RepulsiveForce<T>, Rod>;
-using Solver = Simulation<System, SymplecticVerlet, Blade>;
 
 struct Options {
   T length = 0.05;               // l, m
@@ -60,10 +60,15 @@ struct Options {
   bool velocity_factor = false;  // eps(u_perp) of eq. 23: off, it rectifies the jitter of a light blade
   T normal_damping = 0;          // beta of the coupling's normal dashpot (off: see docs/thin-blades.md)
   bool visibility = true;        // fluid pairs across the blade do not interact (fluid/thin_structure_visibility.hpp)
-  bool global_step = false;      // true: the fluid steps with the rod's own stable step (no sub-cycling)
-  T end_time = 0;                // s; 0: the ramp and the whole towing distance
-  T depth_lengths = 3;           // channel depth in blade lengths (blockage l / depth)
-  T average_from = 3;            // the drag is averaged once the blade has moved this many lengths after the ramp
+  // repulsive: the blade is resolved as an obstacle (eqs 17-23) | drag: porous, it exchanges its Morison drag with
+  // the fluid (coupling/blade_drag.hpp), the drag law of Luhar & Nepf's model itself: a check of the rod and of the
+  // fluid's response, not of the flow around the blade
+  std::string coupling = "repulsive";
+  T blade_cd = 1.95;         // C_D of the drag coupling
+  bool global_step = false;  // true: the fluid steps with the rod's own stable step (no sub-cycling)
+  T end_time = 0;            // s; 0: the ramp and the whole towing distance
+  T depth_lengths = 3;       // channel depth in blade lengths (blockage l / depth)
+  T average_from = 3;        // the drag is averaged once the blade has moved this many lengths after the ramp
   std::vector<T> cauchy{0, 1, 3, 10, 30, 100, 300, 1000};  // 0: the rigid blade
   std::filesystem::path output = "out/blade_in_current";
 };
@@ -78,7 +83,11 @@ T model_effective_length(T ca) {
   return T(1) - (T(1) - T(0.9) * std::cbrt(T(1) / ca)) / (T(1) + T(8) * std::pow(ca, T(-1.5)));
 }
 
+template <class Coupling>
 CaseResult run_case(const Options& o, T target_ca) {
+  using Blade = CoupledBody<Coupling, Rod>;
+  using Solver = Simulation<System, SymplecticVerlet, Blade>;
+  constexpr bool porous = std::is_same_v<Coupling, BladeDrag<T>>;
   const T l = o.length, dp = l / o.particles_along, depth = o.depth_lengths * l, U = o.speed, rho = 1000;
   const T x0 = 2 * l, ramp = T(0.25), tow = o.tow_lengths * l;
   const T tank = x0 + U * ramp / 2 + tow + 3 * l;
@@ -119,10 +128,14 @@ CaseResult run_case(const Options& o, T target_ca) {
   FluidParameters<2, T> fluid;
   fluid.gravity = V::Zero();
   fluid.artificial_viscosity = T(0.02);
-  fluid.thin_structure_visibility = o.visibility;
-  RepulsiveForce<T> coupling;  // eq. 19 with k = 0.01: no hydrostatic load to balance here
-  coupling.velocity_factor = o.velocity_factor;
-  coupling.normal_damping = o.normal_damping;
+  fluid.thin_structure_visibility = o.visibility && !porous;  // the fluid passes a porous blade
+  Coupling coupling;
+  if constexpr (porous) {
+    coupling.drag_coefficient = o.blade_cd;
+  } else {  // eq. 19 with k = 0.01: no hydrostatic load to balance here
+    coupling.velocity_factor = o.velocity_factor;
+    coupling.normal_damping = o.normal_damping;
+  }
   // Sub-cycling (the default): the rod takes its own stable step inside each fluid step. With --global-step the fluid
   // is forced to the rod's step, so the rod takes one sub-step per fluid step (the reference for the saving).
   TimeStepParameters<T> time_step;
@@ -133,7 +146,7 @@ CaseResult run_case(const Options& o, T target_ca) {
   const std::string label = target_ca > 0 ? fmt::format("{:g}", target_ca) : "rigid";
   io::CsvWriter csv(o.output / fmt::format("case_{}.csv", label), {"t", "drag", "tip_dx", "tip_dy"});
   const T t_end = o.end_time > 0 ? o.end_time : ramp + tow / U, t_avg = ramp + o.average_from * l / U;
-  const auto& ids = sim.model<0>().solid().particle_ids();
+  const auto& ids = sim.template model<0>().solid().particle_ids();
   std::vector<T> samples;
   T tip_x = 0, tip_y = 0;
   std::size_t tip_n = 0;
@@ -191,6 +204,10 @@ int main(int argc, char** argv) try {
   o.velocity_factor = cli.get_switch("velocity-factor", false, "eps(u_perp) of eq. 23 in the blade coupling: on | off");
   o.normal_damping =
       cli.get_number("normal-damping", 0, "beta of the blade coupling's normal dashpot (rate beta c0 / h), 0-1");
+  o.coupling = cli.get("coupling", o.coupling,
+                       "blade coupling: repulsive (the blade an obstacle, eqs 17-23) | drag (porous: its Morison drag "
+                       "with --blade-cd, the model's own drag law)");
+  o.blade_cd = cli.get_number("blade-cd", o.blade_cd, "C_D of --coupling drag");
   o.visibility = cli.get_switch("visibility", true,
                                 "on: fluid pairs across the blade do not interact (visibility criterion) | off");
   o.global_step =
@@ -204,6 +221,8 @@ int main(int argc, char** argv) try {
   o.output = cli.get("output", o.output.string(), "output folder");
   if (!cli.finish()) return 0;
   require_positive("--speed (m/s)", o.speed);
+  if (o.coupling != "repulsive" && o.coupling != "drag")
+    throw InputError(fmt::format("--coupling '{}': valid are repulsive, drag", o.coupling));
   require_positive("--length (m)", o.length);
   require_positive("--thickness (m)", o.thickness);
   require_in_range("--resolution (l / dp)", o.particles_along, T(5), T(200));
@@ -220,7 +239,7 @@ int main(int argc, char** argv) try {
   for (const T ca : o.cauchy) {
     fmt::print("--- {}\n", ca > 0 ? fmt::format("Ca = {:g}", ca) : std::string("rigid blade"));
     try {
-      results.push_back(run_case(o, ca));
+      results.push_back(o.coupling == "drag" ? run_case<BladeDrag<T>>(o, ca) : run_case<RepulsiveForce<T>>(o, ca));
     } catch (const BlowUpError& e) {  // a failed case is a result: reported in the table, the others still run
       if (ca == 0) throw;             // without the rigid reference there is nothing to compare with
       fmt::print(stderr, "Ca = {:g}: run stopped: {}\n", ca, e.what());
