@@ -85,6 +85,7 @@ struct Options {
   // repulsive (the repulsive force of eqs 17-23; the fluid leaks through it in the SPH sums, docs/meadow.md)
   std::string coupling = "drag";
   T blade_cd = 1.95, blade_cf = 0, added_mass_coefficient = 1;  // drag coupling: C_D, C_f, C_M
+  bool rigid_blades = false;                                    // drag coupling: every node clamped
   std::filesystem::path out = "out/meadow_decay", empty_from, meadow_from;
 };
 
@@ -169,6 +170,7 @@ RunResult run_case(const Options& o, const std::filesystem::path& dir) {
       how.coupling.friction_coefficient = o.blade_cf;
       how.blade_width = o.blade_width;
       how.added_mass_coefficient = o.added_mass_coefficient;
+      how.rigid = o.rigid_blades;
       return Solver(system, fluid, {}, g.damping_zone(),
                     scenes::add_drag_blades(system, bases, T(0), blade(o), dp, g.smoothing_ratio * dp,
                                             layout.first_free_body, how));
@@ -335,6 +337,9 @@ int main(int argc, char** argv) try {
   o.added_mass_coefficient = cli.get_number(
       "added-mass-coefficient", o.added_mass_coefficient,
       "drag coupling: C_M of the rods' added inertia C_M rho_w pi b / 4 (--added-mass is for the repulsive one)");
+  o.rigid_blades = cli.get_switch("rigid-blades", false,
+                                  "drag coupling: on clamps every node (a rigid canopy: Dalrymple's formula with "
+                                  "--blade-cd is the reference) | off");
   o.check = cli.get_switch("check", false,
                            "on: exit status 4 if a blade tip fell below half its length or, with --coupling "
                            "repulsive, a fluid particle crossed a blade (regression guard)");

@@ -165,6 +165,9 @@ struct DragBladeCoupling {
   T contact_gap_ratio{T(1)};       ///< the bed contact plane's gap over dp
   T stretch_limit{T(1.5)};         ///< BlowUpError above this edge stretch
   int load_smoothing_passes{0};    ///< passes of RodBlades' load filter (the interpolated drag is smooth: none)
+  /// Every node clamped: a rigid canopy, whose wave damping Dalrymple et al.'s (1984) formula gives from C_D alone
+  /// (the check of the drag's energy budget in the flume, docs/meadow.md).
+  bool rigid{false};
 
   void validate() const {
     coupling.validate();
@@ -380,7 +383,10 @@ RodBlades<System, BladeDrag<typename System::scalar_type>> add_drag_blades(
                                  how.contact_gap_ratio * dp);
   std::vector<typename Blades::Blade> blades;
   blades.reserve(rods.size());
-  for (auto& rod : rods) blades.emplace_back(how.coupling, std::move(rod));
+  for (auto& rod : rods) {
+    if (how.rigid) rod.clamp_where([](const Vec<2, typename System::scalar_type>&) { return true; });
+    blades.emplace_back(how.coupling, std::move(rod));
+  }
   return Blades(std::move(blades), how.load_smoothing_passes);
 }
 
