@@ -7,6 +7,7 @@
 #include <sphfsi/integrators/simulation.hpp>
 #include <sphfsi/integrators/symplectic.hpp>
 #include <sphfsi/kernel/wendland_c2.hpp>
+#include <sphfsi/scenes/builders.hpp>
 #include <sphfsi/scenes/meadow.hpp>
 #include <sphfsi/scenes/posidonia_flume.hpp>
 #include <sphfsi/solid/total_lagrangian.hpp>
@@ -302,4 +303,47 @@ TEST_CASE("a real Posidonia blade stands in still water with the coupling's norm
   INFO("no dashpot, 2.5 s: max |dx| " << without.max_abs_dx << " m (water beside the tip " << without.max_abs_water_dx
                                       << " m), min dz " << without.min_dz << " m, crossings " << without.crossings);
   CHECK(without.min_dz < -(1 - std::cos(lean)) * l);  // the failure the dashpot removes: the blade is laid over
+}
+
+TEST_CASE("drag blades: the physical added inertia, rigid canopies, bad input", "[posidonia][meadow]") {
+  using V = Vec<2, double>;
+  const double dp = 0.01;
+  scenes::ThinBlade<double> blade;  // LDPE, 0.14 m on a 0.01 m sheath
+  scenes::DragBladeCoupling<double> how;
+  how.blade_width = 3e-3;
+  // a plate of width b moving normal to itself: C_M rho_w pi b / 4 per unit length and width (2.36 kg/m^2)
+  CHECK_THAT(how.added_mass_per_area(), WithinRel(1000 * std::numbers::pi * 3e-3 / 4, 1e-12));
+  auto moved = [&](bool rigid) {
+    System system(Domain<2, double>(V(-0.1, -0.1), V(0.4, 0.3)), Tait<double>(1000, 10));
+    const Resolution<double> res{dp, 1.3};
+    add_fluid_block(system, V(0, 0), V(0.3, 0.16), res, 0.16, 0.0);
+    for (auto& v : system.particles().velocity) v = V(0.2, 0);  // a current through the blades
+    auto h = how;
+    h.rigid = rigid;
+    h.gravity = 0;
+    auto blades = scenes::add_drag_blades(system, {0.1, 0.15}, 0.0, blade, dp, res.h(), 1, h);
+    const auto& rod = blades.rod(0);
+    const double r = blade.density * blade.thickness;
+    CHECK_THAT(rod.inertia_ratios().back(), WithinRel(r / (r + how.added_mass_per_area()), 1e-12));
+    FluidParameters<2, double> fluid;
+    fluid.gravity = V::Zero();
+    Simulation<System, SymplecticVerlet, decltype(blades)> sim(system, fluid, {}, std::move(blades));
+    for (int k = 0; k < 20; ++k) sim.step();
+    const auto& b = sim.template model<0>();
+    return (b.rod(0).tip_position() - b.rod(0).reference_positions().back()).norm();
+  };
+  const double flexible = moved(false), rigid = moved(true);
+  INFO("tip displacement after 20 steps: flexible " << flexible << " m, rigid " << rigid << " m");
+  CHECK(flexible > 1e-6);  // the drag of the current bends the blade
+  CHECK(rigid == 0.0);
+  auto bad = how;
+  bad.blade_width = 0;
+  CHECK_THROWS_WITH(bad.validate(), Catch::Contains("DragBladeCoupling::blade_width"));
+  bad = how;
+  bad.added_mass_coefficient = 3;
+  CHECK_THROWS_WITH(bad.validate(),
+                    Catch::Contains("DragBladeCoupling::added_mass_coefficient") && Catch::Contains("[0, 2]"));
+  bad = how;
+  bad.coupling.drag_coefficient = -1;
+  CHECK_THROWS_WITH(bad.validate(), Catch::Contains("BladeDrag::drag_coefficient"));
 }
