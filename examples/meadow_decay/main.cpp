@@ -86,6 +86,7 @@ struct Options {
   std::string coupling = "drag";
   T blade_cd = 1.95, blade_cf = 0, added_mass_coefficient = 1;  // drag coupling: C_D, C_f, C_M
   bool rigid_blades = false;                                    // drag coupling: every node clamped
+  T expect_cd = 0;  // > 0: exit 5 unless the fitted bulk C_D is within this relative deviation of blade_cd
   std::filesystem::path out = "out/meadow_decay", empty_from, meadow_from;
 };
 
@@ -340,6 +341,9 @@ int main(int argc, char** argv) try {
   o.rigid_blades = cli.get_switch("rigid-blades", false,
                                   "drag coupling: on clamps every node (a rigid canopy: Dalrymple's formula with "
                                   "--blade-cd is the reference) | off");
+  o.expect_cd = cli.get_number("expect-cd", 0,
+                               "with --rigid-blades on: exit status 5 unless the fitted bulk C_D (empty-normalised, "
+                               "H0 fixed) is within this relative deviation of --blade-cd (0: no check)");
   o.check = cli.get_switch("check", false,
                            "on: exit status 4 if a blade tip fell below half its length or, with --coupling "
                            "repulsive, a fluid particle crossed a blade (regression guard)");
@@ -353,6 +357,11 @@ int main(int argc, char** argv) try {
   require_in_range("--gauge-spacing (m)", o.gauge_spacing, T(0.02), T(2));
   if (runs != "both" && runs != "meadow" && runs != "empty")
     throw InputError(fmt::format("--runs '{}': valid are both, meadow, empty", runs));
+  require_in_range("--expect-cd (relative deviation)", o.expect_cd, T(0), T(1));
+  if (o.expect_cd > 0 && !(o.rigid_blades && o.coupling == "drag" && runs == "both"))
+    throw InputError(
+        "--expect-cd needs --rigid-blades on, --coupling drag and --runs both (the check compares a rigid "
+        "canopy's decay, divided by the empty flume's, with its given C_D)");
   if (o.coupling != "drag" && o.coupling != "repulsive")
     throw InputError(fmt::format("--coupling '{}': valid are drag, repulsive", o.coupling));
   if (o.repulsion != "hydrostatic" && o.repulsion != "stop")
@@ -438,7 +447,9 @@ int main(int argc, char** argv) try {
 
   // bulk drag coefficient over the measured range, simulated (raw and empty-normalised) and measured
   // H0 fitted; where that fit does not converge (a decay far from H0 / (1 + alpha x)), H0 fixed at H(0)
-  auto drag_over_measured_range = [&](const std::vector<T>& r, T h0, const char* label) {
+  analysis::DragCoefficient cd_n_fixed{nan, nan};  // empty-normalised, H0 fixed (the --expect-cd check)
+  auto drag_over_measured_range = [&](const std::vector<T>& r, T h0, const char* label,
+                                      analysis::DragCoefficient* fixed_out = nullptr) {
     std::vector<T> x, H;
     for (std::size_t i = 0; i < xs.size(); ++i)
       if (xs[i] <= mx.back() + 1e-9 && !std::isnan(r[i])) x.push_back(xs[i]), H.push_back(h0 * r[i]);
@@ -450,6 +461,7 @@ int main(int argc, char** argv) try {
       fmt::print("  simulated, {}: no fit with H0 free ({})\n", label, e.what());
     }
     const auto fixed = fitted_drag(o, x, H, h0);
+    if (fixed_out) *fixed_out = fixed;
     fmt::print("  simulated, {}: C_D = {:.3f} +- {:.3f} (H0 fixed at H(0) = {:.2f} mm)\n", label, fixed.value,
                fixed.standard_error, 1e3 * h0);
     return std::isnan(c.value) ? fixed : c;
@@ -467,7 +479,8 @@ int main(int argc, char** argv) try {
   if (have_meadow) {
     try {
       cd = drag_over_measured_range(ratio, with.height[1], "raw");
-      if (have_empty) cd_n = drag_over_measured_range(ratio_empty_normalised, with.height[1], "empty-normalised");
+      if (have_empty)
+        cd_n = drag_over_measured_range(ratio_empty_normalised, with.height[1], "empty-normalised", &cd_n_fixed);
     } catch (const InputError& e) {
       fmt::print("  simulated: no fit ({})\n", e.what());
     }
@@ -530,6 +543,18 @@ int main(int argc, char** argv) try {
   if (std::system(plot.c_str()) != 0) fmt::print("(plot skipped: /usr/bin/python3 with matplotlib not available)\n");
   const bool failed = !with.failure.empty() || !without.failure.empty();
   if (failed) return 3;
+  if (o.expect_cd > 0) {  // a rigid canopy must give back the C_D its drag was given
+    const T deviation = std::abs(cd_n_fixed.value - o.blade_cd) / o.blade_cd;
+    if (!(deviation <= o.expect_cd)) {
+      fmt::print(stderr,
+                 "check failed: bulk C_D {:.3f} (empty-normalised, H0 fixed) deviates {:.1f} % from the blades' "
+                 "C_D = {:.3f} (valid: within {:.1f} %)\n",
+                 cd_n_fixed.value, 100 * deviation, o.blade_cd, 100 * o.expect_cd);
+      return 5;
+    }
+    fmt::print("check passed: bulk C_D {:.3f} within {:.1f} % of the blades' C_D = {:.3f} ({:.1f} %)\n",
+               cd_n_fixed.value, 100 * o.expect_cd, o.blade_cd, 100 * deviation);
+  }
   if (o.check && o.run_meadow) {
     const T half = T(0.5) * (o.blade_length + o.sheath);
     // porous (drag) blades let the fluid through by design: only the repulsive coupling must have no crossing
