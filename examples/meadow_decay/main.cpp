@@ -334,6 +334,10 @@ int main(int argc, char** argv) try {
                        "blade coupling: drag (porous blades exchange their Morison drag with the fluid: the 2D "
                        "stand-in for a 3D canopy) | repulsive (eqs 17-23: impermeable up to the SPH sums' leak)");
   o.blade_cd = cli.get_number("blade-cd", o.blade_cd, "drag coupling: C_D on the blade-normal relative velocity");
+  const bool cd_from_kc = cli.get_switch(
+      "blade-cd-from-kc", false,
+      "on: C_D = max(10 KC^(-1/3), 1.95) (Luhar & Nepf 2016) with KC = U_m T / b of the incident linear wave's "
+      "orbital velocity averaged over the blade height (replaces --blade-cd) | off");
   o.blade_cf = cli.get_number("blade-cf", o.blade_cf, "drag coupling: C_f on the tangential relative velocity");
   o.added_mass_coefficient = cli.get_number(
       "added-mass-coefficient", o.added_mass_coefficient,
@@ -371,6 +375,14 @@ int main(int argc, char** argv) try {
 
   const auto g = flume(o);
   const auto wave = waves::linear_wave(o.period, o.depth);
+  if (cd_from_kc) {  // U_m = (H / 2) omega (1 / l_s) int_0^l_s cosh(k z) dz / sinh(k h), z above the bed
+    const T ls = o.blade_length + o.sheath, k = wave.wave_number;
+    const T um = T(0.5) * o.wave_height * wave.angular_frequency * std::sinh(k * ls) / (k * ls) / std::sinh(wave.kh());
+    const T kc = analysis::keulegan_carpenter_number(um, o.period, o.blade_width);
+    o.blade_cd = analysis::oscillatory_plate_drag_coefficient(kc);
+    fmt::print("blade C_D from KC: U_m = {:.4f} m/s over the blade height, KC = {:.1f}, C_D = {:.3f}\n", um, kc,
+               o.blade_cd);
+  }
   const auto b = blade(o);
   const auto bases = blade_positions(o);
   fmt::print(

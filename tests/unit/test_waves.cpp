@@ -399,3 +399,15 @@ TEST_CASE("fit_line: an exact line, the slope's standard error against Monte Car
   CHECK_THROWS_AS(analysis::fit_line({1.0, 2.0}, {2.0}), InputError);
   CHECK_THROWS_AS(analysis::fit_line({1.0, 2.0}, {2.0, 3.0}, {0.1}), InputError);
 }
+
+TEST_CASE("oscillatory plate drag: C_D = max(10 KC^(-1/3), 1.95) of Luhar & Nepf 2016", "[waves][analysis]") {
+  using namespace sphfsi::analysis;
+  // the Luhar et al. 2017 H1 blades: U_m = 0.1024 m/s (linear wave, canopy mean), T = 1.4286 s, b = 3 mm
+  const double kc = keulegan_carpenter_number(0.1024, 1.4286, 3e-3);
+  CHECK_THAT(kc, Catch::Matchers::WithinRel(48.76, 1e-3));
+  CHECK_THAT(oscillatory_plate_drag_coefficient(kc), Catch::Matchers::WithinRel(10.0 / std::cbrt(48.76), 1e-3));
+  CHECK_THAT(oscillatory_plate_drag_coefficient(1000.0), Catch::Matchers::WithinRel(1.95, 1e-15));  // steady limit
+  CHECK_THAT(oscillatory_plate_drag_coefficient(1.0), Catch::Matchers::WithinRel(10.0, 1e-15));
+  CHECK_THROWS_WITH(keulegan_carpenter_number(0.1, 1.4, 0.0), Catch::Contains("blade width b"));
+  CHECK_THROWS_WITH(oscillatory_plate_drag_coefficient(-1.0), Catch::Contains("KC"));
+}

@@ -21,6 +21,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <optional>
@@ -187,6 +188,23 @@ inline DragCoefficient drag_coefficient(const DecayFit& fit, const StemField& st
       d_alpha * d_alpha * fit.var_alpha + d_H0 * d_H0 * fit.var_height + 2.0 * d_alpha * d_H0 * fit.cov_height_alpha;
   c.standard_error = std::sqrt(std::max(var, 0.0));
   return c;
+}
+
+/// Keulegan-Carpenter number of a blade of width b in oscillatory flow of velocity amplitude U_m and period T:
+/// KC = U_m T / b.
+inline double keulegan_carpenter_number(double velocity_amplitude, double period, double width) {
+  require_positive("keulegan_carpenter_number: velocity amplitude U_m (m/s)", velocity_amplitude);
+  require_positive("keulegan_carpenter_number: period T (s)", period);
+  require_positive("keulegan_carpenter_number: blade width b (m)", width);
+  return velocity_amplitude * period / width;
+}
+
+/// Drag coefficient of a flat plate (a blade) normal to an oscillatory flow: C_D = max(10 KC^(-1/3), 1.95), the fit
+/// of Luhar & Nepf (2016, J. Fluids Struct. 61:20) to the plate data of Keulegan & Carpenter (1958) and Sarpkaya &
+/// O'Keefe (1996); 1.95 is the steady-flow value it tends to at large KC.
+inline double oscillatory_plate_drag_coefficient(double keulegan_carpenter) {
+  require_positive("oscillatory_plate_drag_coefficient: KC", keulegan_carpenter);
+  return std::max(10.0 * std::cbrt(1.0 / keulegan_carpenter), 1.95);
 }
 
 }  // namespace sphfsi::analysis
