@@ -335,9 +335,9 @@ int main(int argc, char** argv) try {
                        "stand-in for a 3D canopy) | repulsive (eqs 17-23: impermeable up to the SPH sums' leak)");
   o.blade_cd = cli.get_number("blade-cd", o.blade_cd, "drag coupling: C_D on the blade-normal relative velocity");
   const bool cd_from_kc = cli.get_switch(
-      "blade-cd-from-kc", false,
+      "blade-cd-from-kc", true,
       "on: C_D = max(10 KC^(-1/3), 1.95) (Luhar & Nepf 2016) with KC = U_m T / b of the incident linear wave's "
-      "orbital velocity averaged over the blade height (replaces --blade-cd) | off");
+      "orbital velocity averaged over the blade height (replaces --blade-cd) | off: --blade-cd");
   o.blade_cf = cli.get_number("blade-cf", o.blade_cf, "drag coupling: C_f on the tangential relative velocity");
   o.added_mass_coefficient = cli.get_number(
       "added-mass-coefficient", o.added_mass_coefficient,

@@ -24,7 +24,8 @@ if(TARGET meadow_decay)
                    --coupling drag --check on
                    --output ${CMAKE_CURRENT_BINARY_DIR}/meadow_drag_guard)
   add_test(NAME meadow.rigid_canopy_drag
-           COMMAND meadow_decay --rigid-blades on --meadow-length 1 --meadow-start 0.5 --expect-cd 0.15
+           COMMAND meadow_decay --rigid-blades on --blade-cd-from-kc off --blade-cd 1.95 --meadow-length 1
+                   --meadow-start 0.5 --expect-cd 0.15
                    --output ${CMAKE_CURRENT_BINARY_DIR}/meadow_rigid_canopy)
   set_tests_properties(meadow.short_meadow_guard meadow.short_drag_meadow_guard PROPERTIES LABELS "regression"
                        TIMEOUT 120 ENVIRONMENT "OMP_NUM_THREADS=1;OMP_WAIT_POLICY=passive")
