@@ -9,10 +9,11 @@
 // sheath modelled as the rigid, clamped lowest part) every dx_b = 1 / (N b) = 0.0463 m (N = 7200 blades/m^2: the
 // frontal area per bed area N b l of the real meadow), each one elastic rod with the real bending stiffness and mass
 // per unit width. By default (--coupling drag) each blade exchanges its Morison drag with the fluid, which passes
-// through it as the water passes between the blades of the 3D meadow (coupling/blade_drag.hpp); --coupling repulsive
-// pushes the fluid on both faces with the repulsive force instead (a 2D wall, up to the leak of the SPH sums through
-// it; docs/meadow.md). The fluid spacing is dx_b / m (m particles between blades; m = 3: h/dp = 10.4), so every
-// blade stands on a lattice line between two fluid columns.
+// through it as the water passes between the blades of the 3D meadow (coupling/blade_drag.hpp), with the plate's
+// C_D = max(10 KC^(-1/3), 1.95) of Luhar & Nepf (2016) at the incident wave's KC (--blade-cd-from-kc);
+// --coupling repulsive pushes the fluid on both faces with the repulsive force instead (a 2D wall, up to the leak
+// of the SPH sums through it; docs/meadow.md). The fluid spacing is dx_b / m (m particles between blades; m = 3:
+// h/dp = 10.4), so every blade stands on a lattice line between two fluid columns.
 //
 // The same flume is run without the meadow (equal resolution): the empty flume's own decay and generation deficit
 // (docs/flume.md) are divided out in the "empty-normalised" H/H0. H0 is the height at the meadow's leading edge of
