@@ -147,6 +147,10 @@ struct RunResult {
   T wall_seconds{0}, reached{0}, max_stretch{1}, lowest_node{std::numeric_limits<T>::quiet_NaN()};
   T lowest_tip{std::numeric_limits<T>::quiet_NaN()};  // over all blades and samples, m above the bed
   std::vector<T> tip_dx_amplitude;                    // first, middle, last blade, m
+  // drag coupling: amplitude sqrt(2) x RMS of the blade-normal velocity of the fluid relative to the free nodes,
+  // and of the fluid's own, over every blade once its waves have arrived, m/s
+  T relative_velocity_amplitude{std::numeric_limits<T>::quiet_NaN()};
+  T fluid_velocity_amplitude{std::numeric_limits<T>::quiet_NaN()};
   std::string failure;
 };
 
@@ -224,6 +228,8 @@ RunResult run_case(const Options& o, const std::filesystem::path& dir) {
   T next_sample = 0, next_snapshot = 0;
   io::ProgressReporter progress(end_time);
   const auto start = std::chrono::steady_clock::now();
+  T relative_square = 0, fluid_square = 0;
+  std::size_t velocity_samples = 0;
   try {
     sim.run(end_time, [&](Solver& sm) {
       progress(sm);
@@ -241,6 +247,22 @@ RunResult run_case(const Options& o, const std::filesystem::path& dir) {
               lo[k] = std::min(lo[k], d[0]), hi[k] = std::max(hi[k], d[0]);
           }
           tips.write_row(row);
+          if constexpr (Kind == Run::drag) {
+            const auto& p = sm.system().particles();
+            for (std::size_t b = 0; b < blades.size(); ++b) {
+              if (!(sm.time() > maker.ramp_time() + bases[b] / wave.group_velocity + wave.period)) continue;
+              const auto& body = blades.blade(b);
+              const auto& ids = body.solid().particle_ids();
+              const auto& X = body.solid().reference_positions();
+              for (std::size_t k = 0; k < ids.size(); ++k) {
+                if (X[k][1] <= o.sheath + T(1e-9)) continue;  // the clamped sheath
+                const std::size_t s = p.slot_of_id(ids[k]);
+                const V u = body.coupling().relative_velocity(sm.system(), body.solid(), k);
+                const T un = u.dot(p.normal[s]), fn = (u + p.velocity[s]).dot(p.normal[s]);
+                relative_square += un * un, fluid_square += fn * fn, ++velocity_samples;
+              }
+            }
+          }
           crossings.update(sm.system(), blades);
           r.max_stretch = std::max(r.max_stretch, blades.max_stretch());
           const T low = blades.lowest_free_node(T(0), o.sheath);
@@ -265,6 +287,10 @@ RunResult run_case(const Options& o, const std::filesystem::path& dir) {
   r.reached = sim.time();
   if constexpr (WithMeadow) r.sub_steps = sim.template model<1>().sub_step_total();
   r.crossings = crossings.total();
+  if (velocity_samples > 0) {
+    r.relative_velocity_amplitude = std::sqrt(T(2) * relative_square / T(velocity_samples));
+    r.fluid_velocity_amplitude = std::sqrt(T(2) * fluid_square / T(velocity_samples));
+  }
   for (std::size_t k = 0; k < 3; ++k) r.tip_dx_amplitude.push_back(hi[k] > lo[k] ? T(0.5) * (hi[k] - lo[k]) : T(0));
   fmt::print("{} steps to t = {:.2f} s, {:.1f} s wall\n", r.steps, r.reached, r.wall_seconds);
 
@@ -505,6 +531,14 @@ int main(int argc, char** argv) try {
         with.lowest_node, with.lowest_tip, with.crossings, 1e3 * with.tip_dx_amplitude[0],
         1e3 * with.tip_dx_amplitude[1], 1e3 * with.tip_dx_amplitude[2],
         with.failure.empty() ? "" : "; FAILED: " + with.failure);
+  }
+  if (o.run_meadow && o.coupling == "drag" && !std::isnan(with.relative_velocity_amplitude)) {
+    const T kc = analysis::keulegan_carpenter_number(with.relative_velocity_amplitude, o.period, o.blade_width);
+    fmt::print(
+        "blade-normal velocity amplitude at the free nodes: fluid {:.4f} m/s, fluid relative to the blade {:.4f} m/s; "
+        "KC of the relative motion {:.1f}, plate-law C_D there {:.3f} (this run used {:.3f})\n",
+        with.fluid_velocity_amplitude, with.relative_velocity_amplitude, kc,
+        analysis::oscillatory_plate_drag_coefficient(kc), o.blade_cd);
   }
   if (o.run_empty)
     fmt::print("empty run: {} + {} particles, {} steps, {:.1f} s wall{}\n", without.fluid, without.wall, without.steps,

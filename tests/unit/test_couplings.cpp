@@ -390,6 +390,9 @@ TEST_CASE("blade drag: the Morison force of a uniform stream on an inclined blad
   INFO("force on the blade (" << on_blade.transpose() << ") N/m, Morison (" << expected.transpose() << ")");
   CHECK((on_blade - expected).norm() <= 1e-12 * expected.norm());
   CHECK(total.norm() <= 1e-12 * scale);  // the fluid receives exactly the opposite
+  const Rod rod = free_blade(system);    // the relative velocity the drag acts on: the stream's, blade at rest
+  for (std::size_t k = 0; k < rod.particle_ids().size(); ++k)
+    CHECK((drag.relative_velocity(system, rod, k) - V(U, 0)).norm() <= 1e-12 * U);
 
   // Random velocities of fluid and blade: momentum to round-off, and the coupling only dissipates.
   std::mt19937 rng(11);

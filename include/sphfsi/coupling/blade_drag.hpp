@@ -86,6 +86,16 @@ struct BladeDrag {
     return dt;
   }
 
+  /// The velocity of the fluid relative to node k, u_f(x_k) - v_k (zero for a node with no fluid in its support):
+  /// what the drag acts on, e.g. for the Keulegan-Carpenter number of the relative motion.
+  template <class System, class Solid>
+  Vec<2, T> relative_velocity(const System& system, const Solid& solid, std::size_t k) const {
+    const auto& ids = solid.particle_ids();
+    const Sample s = sample(system, ids, k);
+    if (!(s.weight_sum > T(0))) return Vec<2, T>::Zero();
+    return s.fluid_velocity - system.particles().velocity[system.particles().slot_of_id(ids[k])];
+  }
+
   template <class System, class Solid>
   void apply(System& system, const Solid& solid, T /*time*/) const {
     static_assert(System::dimension == 2, "BladeDrag: 2D thin structures only");

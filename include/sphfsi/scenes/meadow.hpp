@@ -221,6 +221,8 @@ class RodBlades {
 
   std::size_t size() const noexcept { return blades_.size(); }
   const Rod& rod(std::size_t k) const { return blades_.at(k).solid(); }
+  /// The coupled body of blade k (its coupling and rod).
+  const Blade& blade(std::size_t k) const { return blades_.at(k); }
   /// Rod sub-steps summed over the blades.
   std::size_t sub_step_total() const {
     std::size_t n = 0;
