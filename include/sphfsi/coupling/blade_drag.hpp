@@ -16,8 +16,9 @@
 // coupling only dissipates. Morison et al. (1950) for the force form; its use for flexible blades resolved as beams
 // with the normal and tangential components above: Luhar & Nepf (2016, J. Fluids Struct. 61:20), who also include
 // the added-mass force (here the rod's added inertia, ElasticRodParameters::added_mass_per_area; the force of the
-// fluid's own acceleration is not included) and a Keulegan-Carpenter dependent C_D. A node with no fluid in its
-// support (above the free surface) exchanges nothing.
+// fluid's own acceleration is not included) and a Keulegan-Carpenter dependent C_D (analysis/vegetation_drag.hpp:
+// oscillatory_plate_drag_coefficient). A node with no fluid in its support (above the free surface) exchanges
+// nothing.
 //
 // Limits: it needs a thin structure (one line of nodes with published normals, solid/elastic_rod.hpp). It does not
 // keep the fluid on one side of the blade (crossings are the point here), so it is not the coupling for a blade
