@@ -87,7 +87,8 @@ struct Options {
   std::string coupling = "drag";
   T blade_cd = 1.95, blade_cf = 0, added_mass_coefficient = 1;  // drag coupling: C_D, C_f, C_M
   bool rigid_blades = false;                                    // drag coupling: every node clamped
-  T expect_cd = 0;  // > 0: exit 5 unless the fitted bulk C_D is within this relative deviation of blade_cd
+  int kc_iterations = 0;  // drag coupling: reruns with C_D from the relative motion's KC
+  T expect_cd = 0;        // > 0: exit 5 unless the fitted bulk C_D is within this relative deviation of blade_cd
   std::filesystem::path out = "out/meadow_decay", empty_from, meadow_from;
 };
 
@@ -375,6 +376,9 @@ int main(int argc, char** argv) try {
   o.expect_cd = cli.get_number("expect-cd", 0,
                                "with --rigid-blades on: exit status 5 unless the fitted bulk C_D (empty-normalised, "
                                "H0 fixed) is within this relative deviation of --blade-cd (0: no check)");
+  o.kc_iterations = int(cli.get_number("kc-iterations", 0,
+                                       "drag coupling: rerun the meadow this many times, each with the plate-law "
+                                       "C_D at the KC of the last run's velocity relative to the blades (0-10)"));
   o.check = cli.get_switch("check", false,
                            "on: exit status 4 if a blade tip fell below half its length or, with --coupling "
                            "repulsive, a fluid particle crossed a blade (regression guard)");
@@ -389,6 +393,9 @@ int main(int argc, char** argv) try {
   if (runs != "both" && runs != "meadow" && runs != "empty")
     throw InputError(fmt::format("--runs '{}': valid are both, meadow, empty", runs));
   require_in_range("--expect-cd (relative deviation)", o.expect_cd, T(0), T(1));
+  require_in_range("--kc-iterations", o.kc_iterations, 0, 10);
+  if (o.kc_iterations > 0 && o.coupling != "drag")
+    throw InputError("--kc-iterations needs --coupling drag (the relative velocity is the drag coupling's)");
   if (o.expect_cd > 0 && !(o.rigid_blades && o.coupling == "drag" && runs == "both"))
     throw InputError(
         "--expect-cd needs --rigid-blades on, --coupling drag and --runs both (the check compares a rigid "
@@ -425,9 +432,20 @@ int main(int argc, char** argv) try {
       b.bending_stiffness_per_width(), b.node_count(g.dp()));
 
   RunResult with, without;
-  if (o.run_meadow)
-    with =
-        o.coupling == "drag" ? run_case<Run::drag>(o, o.out / "meadow") : run_case<Run::repulsive>(o, o.out / "meadow");
+  if (o.run_meadow && o.coupling == "drag") {
+    // --kc-iterations: rerun with the plate-law C_D of the last run's relative motion (Luhar & Nepf's KC)
+    for (int it = 0;; ++it) {
+      with = run_case<Run::drag>(o, o.out / "meadow");
+      if (it == o.kc_iterations || !with.failure.empty() || std::isnan(with.relative_velocity_amplitude)) break;
+      const T kc = analysis::keulegan_carpenter_number(with.relative_velocity_amplitude, o.period, o.blade_width);
+      const T next = analysis::oscillatory_plate_drag_coefficient(kc);
+      fmt::print("KC iteration {}: relative velocity amplitude {:.4f} m/s, KC {:.1f}: C_D {:.3f} -> {:.3f}\n", it + 1,
+                 with.relative_velocity_amplitude, kc, o.blade_cd, next);
+      o.blade_cd = next;
+    }
+  } else if (o.run_meadow) {
+    with = run_case<Run::repulsive>(o, o.out / "meadow");
+  }
   if (o.run_empty) without = run_case<Run::empty>(o, o.out / "empty");
   const auto gx = gauge_positions(o);
   auto heights_from = [&](const std::filesystem::path& file, const char* flag) {
