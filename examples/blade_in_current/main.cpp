@@ -113,9 +113,9 @@ CaseResult run_case(const Options& o, T target_ca) {
   params.section = section;
   params.gravity = V::Zero();
   // A porous blade does not move the fluid aside, so its added mass must be the rod's: that of a plate of width b
-  // moving normal to itself, rho pi b / 4 per unit length and width (scenes::DragBladeCoupling). The repulsive blade
-  // pushes the fluid and gets its added mass from it.
-  if constexpr (porous) params.added_mass_per_area = rho * std::numbers::pi_v<T> * section.width / 4;
+  // moving normal to itself, rho pi b / 4 per unit length and width. The repulsive blade pushes the fluid and gets
+  // its added mass from it.
+  if constexpr (porous) params.added_mass_per_area = plate_added_mass_per_area(rho, section.width);
   Rod rod(system, 1, material, params);
   // A blade folding over rests one fluid spacing above the bed: the fluid trapped under it keeps a row of room
   // (at dp / 2 the first fluid row was crushed between the bed and the blade, a blow-up at Ca = 390).

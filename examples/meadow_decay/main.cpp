@@ -95,6 +95,15 @@ struct Options {
 T blade_spacing(const Options& o) { return scenes::equivalent_blade_spacing(o.blades_per_square_metre, o.blade_width); }
 T particle_spacing(const Options& o) { return blade_spacing(o) / o.particles_per_gap; }
 
+/// KC = U_m T / b of a blade-normal velocity amplitude U_m and the plate's C_D there (Luhar & Nepf 2016).
+struct PlateDrag {
+  T kc, drag_coefficient;
+};
+PlateDrag plate_drag(const Options& o, T velocity_amplitude) {
+  const T kc = analysis::keulegan_carpenter_number(velocity_amplitude, o.period, o.blade_width);
+  return {kc, analysis::oscillatory_plate_drag_coefficient(kc)};
+}
+
 scenes::WaveFlumeGeometry<T> flume(const Options& o) {
   scenes::WaveFlumeGeometry<T> g;
   g.wave.paddle = waves::PaddleType::piston;
@@ -412,9 +421,9 @@ int main(int argc, char** argv) try {
   if (cd_from_kc) {  // U_m = (H / 2) omega (1 / l_s) int_0^l_s cosh(k z) dz / sinh(k h), z above the bed
     const T ls = o.blade_length + o.sheath, k = wave.wave_number;
     const T um = T(0.5) * o.wave_height * wave.angular_frequency * std::sinh(k * ls) / (k * ls) / std::sinh(wave.kh());
-    const T kc = analysis::keulegan_carpenter_number(um, o.period, o.blade_width);
-    o.blade_cd = analysis::oscillatory_plate_drag_coefficient(kc);
-    fmt::print("blade C_D from KC: U_m = {:.4f} m/s over the blade height, KC = {:.1f}, C_D = {:.3f}\n", um, kc,
+    const PlateDrag plate = plate_drag(o, um);
+    o.blade_cd = plate.drag_coefficient;
+    fmt::print("blade C_D from KC: U_m = {:.4f} m/s over the blade height, KC = {:.1f}, C_D = {:.3f}\n", um, plate.kc,
                o.blade_cd);
   }
   const auto b = blade(o);
@@ -437,11 +446,10 @@ int main(int argc, char** argv) try {
     for (int it = 0;; ++it) {
       with = run_case<Run::drag>(o, o.out / "meadow");
       if (it == o.kc_iterations || !with.failure.empty() || std::isnan(with.relative_velocity_amplitude)) break;
-      const T kc = analysis::keulegan_carpenter_number(with.relative_velocity_amplitude, o.period, o.blade_width);
-      const T next = analysis::oscillatory_plate_drag_coefficient(kc);
+      const PlateDrag next = plate_drag(o, with.relative_velocity_amplitude);
       fmt::print("KC iteration {}: relative velocity amplitude {:.4f} m/s, KC {:.1f}: C_D {:.3f} -> {:.3f}\n", it + 1,
-                 with.relative_velocity_amplitude, kc, o.blade_cd, next);
-      o.blade_cd = next;
+                 with.relative_velocity_amplitude, next.kc, o.blade_cd, next.drag_coefficient);
+      o.blade_cd = next.drag_coefficient;
     }
   } else if (o.run_meadow) {
     with = run_case<Run::repulsive>(o, o.out / "meadow");
@@ -551,12 +559,12 @@ int main(int argc, char** argv) try {
         with.failure.empty() ? "" : "; FAILED: " + with.failure);
   }
   if (o.run_meadow && o.coupling == "drag" && !std::isnan(with.relative_velocity_amplitude)) {
-    const T kc = analysis::keulegan_carpenter_number(with.relative_velocity_amplitude, o.period, o.blade_width);
+    const PlateDrag relative = plate_drag(o, with.relative_velocity_amplitude);
     fmt::print(
         "blade-normal velocity amplitude at the free nodes: fluid {:.4f} m/s, fluid relative to the blade {:.4f} m/s; "
         "KC of the relative motion {:.1f}, plate-law C_D there {:.3f} (this run used {:.3f})\n",
-        with.fluid_velocity_amplitude, with.relative_velocity_amplitude, kc,
-        analysis::oscillatory_plate_drag_coefficient(kc), o.blade_cd);
+        with.fluid_velocity_amplitude, with.relative_velocity_amplitude, relative.kc, relative.drag_coefficient,
+        o.blade_cd);
   }
   if (o.run_empty)
     fmt::print("empty run: {} + {} particles, {} steps, {:.1f} s wall{}\n", without.fluid, without.wall, without.steps,

@@ -406,7 +406,6 @@ TEST_CASE("blade drag: the Morison force of a uniform stream on an inclined blad
       sum += p.mass[i] * p.acceleration[i];
       power += p.mass[i] * p.acceleration[i].dot(p.velocity[i]);
       magnitude += std::abs(p.mass[i] * p.acceleration[i].dot(p.velocity[i]));
-      scale = std::max(scale, p.mass[i] * p.acceleration[i].norm());
     }
     CHECK(sum.norm() <= 1e-12 * magnitude / 0.3);
     CHECK(power <= 1e-12 * magnitude);

@@ -33,9 +33,18 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <vector>
 
 namespace sphfsi {
+
+/// Added mass per unit length and unit width of a flat plate of width b moving normal to itself, C_M rho pi b / 4,
+/// kg/m^2 (potential flow: C_M = 1). A porous blade does not move the fluid aside, so the rod has to carry it
+/// (ElasticRodParameters::added_mass_per_area).
+template <Real T>
+T plate_added_mass_per_area(T fluid_density, T width, T coefficient = T(1)) {
+  return coefficient * fluid_density * std::numbers::pi_v<T> * width / T(4);
+}
 
 template <Real T>
 struct BladeDrag {

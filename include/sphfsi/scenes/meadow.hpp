@@ -180,7 +180,7 @@ struct DragBladeCoupling {
   }
   /// Added inertia per unit length and width, C_M rho_w pi b / 4, kg/m^2.
   T added_mass_per_area() const {
-    return added_mass_coefficient * ambient_density * T(3.14159265358979323846) * blade_width / T(4);
+    return plate_added_mass_per_area(ambient_density, blade_width, added_mass_coefficient);
   }
 };
 
@@ -294,11 +294,11 @@ std::vector<ElasticRod<System>> blade_rods(System& system, const std::vector<typ
                                            typename System::scalar_type dp,
                                            typename System::scalar_type smoothing_length, std::int32_t first_body,
                                            const typename ElasticRod<System>::Parameters& params,
-                                           typename System::scalar_type contact_gap) {
+                                           typename System::scalar_type contact_gap, const char* caller) {
   using T = typename System::scalar_type;
   using V = Vec<2, T>;
   using Rod = ElasticRod<System>;
-  if (base_x.empty()) throw InputError("add_rod_blades: no blade positions given (valid: at least one)");
+  if (base_x.empty()) throw InputError(fmt::format("{}: no blade positions given (valid: at least one)", caller));
   const int nodes = blade.node_count(dp);
   for (std::size_t k = 0; k < base_x.size(); ++k)
     add_elastic_rod(system, V(base_x[k], bed), V(0, 1), blade.length, nodes, blade.material(),
@@ -360,7 +360,7 @@ RodBlades<System> add_rod_blades(System& system, const std::vector<typename Syst
   const auto params = detail::blade_rod_parameters<System>(blade, how.gravity, how.ambient_density, how.stretch_limit,
                                                            how.added_mass_ratio * how.ambient_density * dp);
   auto rods = detail::blade_rods(system, base_x, bed, blade, dp, smoothing_length, first_body, params,
-                                 how.contact_gap_ratio * dp);
+                                 how.contact_gap_ratio * dp, "add_rod_blades");
   std::vector<typename RodBlades<System>::Blade> blades;
   blades.reserve(rods.size());
   for (auto& rod : rods) blades.emplace_back(coupling, std::move(rod));
@@ -382,7 +382,7 @@ RodBlades<System, BladeDrag<typename System::scalar_type>> add_drag_blades(
   const auto params = detail::blade_rod_parameters<System>(blade, how.gravity, how.ambient_density, how.stretch_limit,
                                                            how.added_mass_per_area());
   auto rods = detail::blade_rods(system, base_x, bed, blade, dp, smoothing_length, first_body, params,
-                                 how.contact_gap_ratio * dp);
+                                 how.contact_gap_ratio * dp, "add_drag_blades");
   std::vector<typename Blades::Blade> blades;
   blades.reserve(rods.size());
   for (auto& rod : rods) {
