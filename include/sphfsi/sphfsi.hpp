@@ -24,6 +24,7 @@
 #include <sphfsi/eos/linear.hpp>
 #include <sphfsi/eos/tait.hpp>
 #include <sphfsi/fluid/particle_refinement.hpp>
+#include <sphfsi/fluid/thin_structure_visibility.hpp>
 #include <sphfsi/fluid/wcsph.hpp>
 #include <sphfsi/integrators/concepts.hpp>
 #include <sphfsi/integrators/predictor_corrector.hpp>
@@ -41,10 +42,13 @@
 #include <sphfsi/kernel/quintic_spline.hpp>
 #include <sphfsi/kernel/wendland_c2.hpp>
 #include <sphfsi/neighbors/cell_list.hpp>
+#include <sphfsi/neighbors/multilevel_cell_list.hpp>
 #include <sphfsi/scenes/antoci_gate.hpp>
 #include <sphfsi/scenes/builders.hpp>
 #include <sphfsi/scenes/dam_break.hpp>
 #include <sphfsi/scenes/gate_tip_comparison.hpp>
+#include <sphfsi/scenes/meadow.hpp>
+#include <sphfsi/scenes/posidonia_flume.hpp>
 #include <sphfsi/scenes/solid_builders.hpp>
 #include <sphfsi/scenes/surge_front_comparison.hpp>
 #include <sphfsi/scenes/wave_flume.hpp>
@@ -57,4 +61,5 @@
 #include <sphfsi/waves/damping_zone.hpp>
 #include <sphfsi/waves/gauges.hpp>
 #include <sphfsi/waves/linear_theory.hpp>
+#include <sphfsi/waves/second_order.hpp>
 #include <sphfsi/waves/wavemaker.hpp>
