@@ -418,9 +418,8 @@ int main(int argc, char** argv) try {
 
   const auto g = flume(o);
   const auto wave = waves::linear_wave(o.period, o.depth);
-  if (cd_from_kc) {  // U_m = (H / 2) omega (1 / l_s) int_0^l_s cosh(k z) dz / sinh(k h), z above the bed
-    const T ls = o.blade_length + o.sheath, k = wave.wave_number;
-    const T um = T(0.5) * o.wave_height * wave.angular_frequency * std::sinh(k * ls) / (k * ls) / std::sinh(wave.kh());
+  if (cd_from_kc) {  // U_m: the incident wave's orbital velocity amplitude averaged over the blade height
+    const T um = wave.canopy_orbital_velocity(o.wave_height, o.blade_length + o.sheath);
     const PlateDrag plate = plate_drag(o, um);
     o.blade_cd = plate.drag_coefficient;
     fmt::print("blade C_D from KC: U_m = {:.4f} m/s over the blade height, KC = {:.1f}, C_D = {:.3f}\n", um, plate.kc,

@@ -2,8 +2,10 @@
 //
 // Still-water depth h = 0.2 m, piston paddle at x = 0, one plant (or a meadow of N plants) clamped in the bed from
 // x = 1.2 m, gauges at x = 0.6, 1.0, 1.3 and 1.7 m, a damping zone beyond x = 2 m (scenes/posidonia_flume.hpp).
-// The plants are the real blades (--blade rod, the default: one elastic rod per plant, t = 0.1 mm, pushed on both
-// faces; scenes/meadow.hpp) or total-Lagrangian continuum blades 3 particles thick (--blade scaled|equivalent),
+// The plants are the real blades as elastic rods (t = 0.1 mm): porous rows of leaves that exchange their Morison
+// drag with the water (--blade drag, the default: coupling/blade_drag.hpp), or full-width blades pushed on both
+// faces (--blade rod; scenes/meadow.hpp); or total-Lagrangian continuum blades 3 particles thick (--blade
+// scaled|equivalent),
 // coupled to the fluid by the paper's retained repulsive-force coupling (eqs 17-23; for the continuum blades with
 // the depth factor eps(z) referred to the still-water level). The same flume is run
 // with and without plants at equal resolution (the empty flume loses 11-15 % of the height per wavelength at
@@ -86,18 +88,24 @@ scenes::PosidoniaFlume<T> converted(const scenes::PosidoniaFlume<double>& s) {
   c.rod_load_smoothing = s.rod_load_smoothing, c.rod_velocity_factor = s.rod_velocity_factor;
   c.rod_normal_damping = T(s.rod_normal_damping);
   c.rod_repulsion = T(s.rod_repulsion);
+  c.leaf_width = T(s.leaf_width), c.drag_coefficient = T(s.drag_coefficient);
+  c.friction_coefficient = T(s.friction_coefficient), c.added_mass_coefficient = T(s.added_mass_coefficient);
   return c;
 }
 
-/// What stands in the flume: nothing, continuum blades (scaled, equivalent) or rods (the real blade).
-enum class Plants { none, continuum, rods };
+/// What stands in the flume: nothing, continuum blades (scaled, equivalent), rods (the real blade) pushed on both
+/// faces, or porous drag rods.
+enum class Plants { none, continuum, rods, drag_rods };
 
 template <class T, Plants Kind>
 CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
-  constexpr bool WithPlants = Kind != Plants::none, Rods = Kind == Plants::rods;
+  constexpr bool WithPlants = Kind != Plants::none, Drag = Kind == Plants::drag_rods;
+  constexpr bool Rods = Kind == Plants::rods || Drag;  // a rod per plant (RodBlades)
   using System = ParticleSystem<2, T, WendlandC2<2>, Tait<T>>;
   using Solid = TotalLagrangianSolid<System>;
-  using Plant = std::conditional_t<Rods, scenes::RodBlades<System>, CoupledBody<RepulsiveForce<T>, Solid>>;
+  using Plant =
+      std::conditional_t<Drag, scenes::RodBlades<System, BladeDrag<T>>,
+                         std::conditional_t<Rods, scenes::RodBlades<System>, CoupledBody<RepulsiveForce<T>, Solid>>>;
   using Solver = std::conditional_t<WithPlants, Simulation<System, SymplecticVerlet, waves::DampingZone<T>, Plant>,
                                     Simulation<System, SymplecticVerlet, waves::DampingZone<T>>>;
   scenes::PosidoniaFlume<T> scene = converted<T>(o.scene);
@@ -113,7 +121,10 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
   TimeStepParameters<T> stepping;
   stepping.cfl = T(o.cfl);
   auto make_solver = [&]() {
-    if constexpr (Rods) {
+    if constexpr (Drag) {
+      return Solver(system, fluid, stepping, g.damping_zone(),
+                    scenes::add_posidonia_drag_blades(system, scene, layout));
+    } else if constexpr (Rods) {
       return Solver(system, fluid, stepping, g.damping_zone(), scenes::add_posidonia_rods(system, scene, layout));
     } else if constexpr (WithPlants) {
       typename Solid::Parameters params;
@@ -217,7 +228,7 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
           if constexpr (Rods) {
             const auto& rods = sm.template model<1>();
             r.max_stretch = std::max(r.max_stretch, double(rods.max_stretch()));
-            crossings.update(sm.system(), rods);
+            if constexpr (!Drag) crossings.update(sm.system(), rods);  // porous blades: the water passes
             const double low = double(rods.lowest_free_node(T(0), T(0)));
             r.lowest_node = std::isnan(r.lowest_node) ? low : std::min(r.lowest_node, low);
           } else {
@@ -290,7 +301,13 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
 }
 
 const char* blade_name(scenes::BladeModel b) {
-  return b == scenes::BladeModel::rod ? "rod" : b == scenes::BladeModel::scaled ? "scaled" : "equivalent";
+  switch (b) {
+    case scenes::BladeModel::rod: return "rod";
+    case scenes::BladeModel::drag: return "drag";
+    case scenes::BladeModel::scaled: return "scaled";
+    case scenes::BladeModel::equivalent: return "equivalent";
+  }
+  return "?";
 }
 
 template <class T>
@@ -322,7 +339,7 @@ int run(const Options& o) {
       double(m.p_wave_speed()), double(scene.model_bending_stiffness()), double(scene.real_bending_stiffness()),
       double(scene.model_bending_stiffness() / scene.real_bending_stiffness()),
       double(m.density * scene.blade_thickness()), double(scene.real_density * scene.real_thickness));
-  if (scene.blade == scenes::BladeModel::rod) {
+  if (scene.thin_blade()) {
     const auto b = scene.rod_blade();
     fmt::print(
         "rod blades: {} nodes (ds = {:.4f} m), t = {} m, E = {:.3g} Pa, rho = {} kg/m^3, E t^3/12 = {:.3g} N m, "
@@ -331,11 +348,26 @@ int run(const Options& o) {
         double(b.youngs_modulus), double(b.density), double(b.bending_stiffness_per_width()),
         double(b.mass_per_area()));
   }
+  if (scene.blade == scenes::BladeModel::drag) {
+    const T a = T(1) / scene.spacing;
+    fmt::print(
+        "porous blades: each plant a row of leaves b = {} m wide across the flume; C_D = {:.3f} ({}), C_f = {}, "
+        "added inertia C_M rho_w pi b / 4 = {:.3g} kg/m^2 (C_M = {}); KC of the incident wave over the blade height "
+        "{:.1f}{}\n",
+        double(scene.leaf_width), double(scene.blade_drag_coefficient()),
+        scene.drag_coefficient > T(0) ? "given" : "plate law at the incident KC", double(scene.friction_coefficient),
+        double(plate_added_mass_per_area(T(1000), scene.leaf_width, scene.added_mass_coefficient)),
+        double(scene.added_mass_coefficient), double(scene.keulegan_carpenter_number()),
+        scene.plants > 1 ? fmt::format("; meadow frontal area a = 1 / spacing = {:.1f} 1/m ({:.0f} leaves per m^2)",
+                                       double(a), double(a / scene.leaf_width))
+                         : std::string());
+  }
 
   CaseResult with, without;
   if (o.run_plants)
-    with = scene.blade == scenes::BladeModel::rod ? run_case<T, Plants::rods>(o, o.out / "plants")
-                                                  : run_case<T, Plants::continuum>(o, o.out / "plants");
+    with = scene.blade == scenes::BladeModel::drag  ? run_case<T, Plants::drag_rods>(o, o.out / "plants")
+           : scene.blade == scenes::BladeModel::rod ? run_case<T, Plants::rods>(o, o.out / "plants")
+                                                    : run_case<T, Plants::continuum>(o, o.out / "plants");
   if (o.run_empty) without = run_case<T, Plants::none>(o, o.out / "empty");
   const bool have_empty = o.run_empty || !o.empty_from.empty();
   if (!o.run_empty && have_empty) {  // the empty flume of an earlier run at the same waves and resolution
@@ -426,9 +458,9 @@ int main(int argc, char** argv) try {
   s.first_plant_x = cli.get_number("plant-x", 1.2, "centre line of the first plant, m");
   s.height_ratio = cli.get_number("height-ratio", 0.4, "blade length / depth (paper: 0.32 to 0.5)");
   const std::string blade =
-      cli.get("blade", "rod",
-              "blade model: rod (the real blade, t = 0.1 mm) | scaled (paper Table 3) | equivalent (blows up: "
-              "docs/posidonia.md)");
+      cli.get("blade", "drag",
+              "blade model: drag (the real blade, t = 0.1 mm, as porous rows of leaves) | rod (the real blade, "
+              "full width, pushed on both faces) | scaled (paper Table 3) | equivalent (blows up: docs/posidonia.md)");
   s.blade_rows = int(cli.get_number("blade-rows", 3, "particle rows across the blade"));
   s.equivalent_bulk_modulus =
       cli.get_number("bulk-modulus", 1e5, "bulk modulus of the equivalent blade, Pa (bending unaffected)");
@@ -440,6 +472,11 @@ int main(int argc, char** argv) try {
       cli.get_number("normal-damping", 0.5, "rod blade: beta of the coupling's normal dashpot (rate beta c0 / h)");
   s.rod_repulsion =
       cli.get_number("repulsion", 0, "rod blade: k of eq. 19, A = k c0^2 / h (0: stops 3 x the orbital velocity)");
+  s.leaf_width = cli.get_number("leaf-width", 0.01, "drag blade: width b of one leaf, m");
+  s.drag_coefficient = cli.get_number("blade-cd", 0, "drag blade: C_D (0: the plate law at the incident wave's KC)");
+  s.friction_coefficient = cli.get_number("blade-cf", 0, "drag blade: C_f of the tangential skin friction");
+  s.added_mass_coefficient =
+      cli.get_number("added-mass-coefficient", 1, "drag blade: C_M of the leaf's added inertia C_M rho_w pi b / 4");
   s.poisson_ratio = cli.get_number("poisson", 0.3, "Poisson ratio of the real and scaled blade");
   s.real_density = cli.get_number("real-density", 910, "density of the real blade, kg/m^3");
   s.real_youngs_modulus = cli.get_number("real-modulus", 4.7e8, "Young's modulus of the real blade, Pa");
@@ -462,9 +499,12 @@ int main(int argc, char** argv) try {
   if (blade == "equivalent") s.blade = scenes::BladeModel::equivalent;
   else if (blade == "scaled") s.blade = scenes::BladeModel::scaled;
   else if (blade == "rod") s.blade = scenes::BladeModel::rod;
-  else throw InputError(fmt::format("--blade '{}': valid are rod, equivalent, scaled", blade));
+  else if (blade == "drag") s.blade = scenes::BladeModel::drag;
+  else throw InputError(fmt::format("--blade '{}': valid are drag, rod, equivalent, scaled", blade));
   // the rod's axial strains (1e-6) are below float's position resolution over a metre (6e-8 m on 5 mm edges)
-  if (precision == "auto") precision = s.blade == scenes::BladeModel::rod ? "double" : "float";
+  if (precision == "auto") precision = s.thin_blade() ? "double" : "float";
+  if (o.visibility && s.blade == scenes::BladeModel::drag)
+    throw InputError("--visibility on: only for --blade rod (the porous drag blades let the water through)");
   if (runs != "both" && runs != "plants" && runs != "empty")
     throw InputError(fmt::format("--runs '{}': valid are both, plants, empty", runs));
   o.run_plants = runs != "empty" && !no_plants && s.plants > 0;

@@ -144,8 +144,8 @@ TEST_CASE("real blades: the 2D meadow spacing, E from EI, the repulsion that sto
 
 TEST_CASE("posidonia rod plants: the real blade on lattice lines, no fluid removed", "[posidonia][meadow]") {
   scenes::PosidoniaFlume<double> s;
-  REQUIRE(s.blade == scenes::BladeModel::rod);  // the default
-  s.particles_per_depth = 10;                   // dp = 2 cm
+  s.blade = scenes::BladeModel::rod;
+  s.particles_per_depth = 10;  // dp = 2 cm
   s.absorber_start = 1.8;
   s.plants = 3;
   s.spacing = 0.12;
@@ -252,6 +252,7 @@ struct StillWaterBlade {
 StillWaterBlade still_water_blade(double beta, double end_time) {
   using V = Vec<2, double>;
   scenes::PosidoniaFlume<double> s;
+  s.blade = scenes::BladeModel::rod;
   s.particles_per_depth = 10;
   s.rod_normal_damping = beta;
   const auto g = s.flume();
@@ -346,4 +347,52 @@ TEST_CASE("drag blades: the physical added inertia, rigid canopies, bad input", 
   bad = how;
   bad.coupling.drag_coefficient = -1;
   CHECK_THROWS_WITH(bad.validate(), Catch::Contains("BladeDrag::drag_coefficient"));
+}
+
+TEST_CASE("posidonia drag plants: porous rows of real leaves, C_D from the incident wave's KC", "[posidonia][meadow]") {
+  scenes::PosidoniaFlume<double> s;
+  REQUIRE(s.blade == scenes::BladeModel::drag);  // the default
+  s.particles_per_depth = 10;                    // dp = 2 cm
+  s.absorber_start = 1.8;
+  s.plants = 2;
+  s.spacing = 0.1;
+  // KC = U_m T / b with U_m = (H / 2) omega sinh(k l) / (k l sinh(k h)), by hand from the dispersion relation
+  const auto w = waves::linear_wave(1.2, 0.2);
+  const double l = s.blade_length(), kl = w.wave_number * l;
+  const double um = 0.5 * 0.03 * (2 * std::numbers::pi / 1.2) * std::sinh(kl) / kl / std::sinh(w.kh());
+  const double kc = um * 1.2 / 0.01;
+  CHECK_THAT(s.keulegan_carpenter_number(), WithinRel(kc, 1e-12));
+  CHECK_THAT(s.blade_drag_coefficient(), WithinRel(std::max(10 * std::cbrt(1 / kc), 1.95), 1e-12));
+  s.drag_coefficient = 2.5;  // given
+  CHECK(s.blade_drag_coefficient() == 2.5);
+  s.drag_coefficient = 0;
+
+  const auto g = s.flume();
+  System system(scenes::wave_flume_domain(g), Tait<double>(1000, g.sound_speed()));
+  const auto layout = scenes::build_posidonia_flume(system, s);
+  CHECK(layout.solid_particles == 0);  // the rods are added next, no fluid is removed
+  const auto plants = scenes::add_posidonia_drag_blades(system, s, layout);
+  REQUIRE(plants.size() == 2);
+  for (std::size_t k = 0; k < plants.size(); ++k) {
+    const auto& rod = plants.rod(k);
+    CHECK_THAT(rod.bending_stiffness(), WithinRel(4.7e8 * 1e-12 / 12, 1e-12));  // E t^3 / 12 per unit width
+    const double r = 910 * 1e-4, added = 1000 * std::numbers::pi * 0.01 / 4;    // rho t, C_M rho_w pi b / 4
+    CHECK_THAT(rod.inertia_ratios().back(), WithinRel(r / (r + added), 1e-12));
+    CHECK_THAT(plants.blade(k).coupling().drag_coefficient, WithinRel(s.blade_drag_coefficient(), 1e-12));
+  }
+  auto bad = s;
+  bad.leaf_width = 0;
+  CHECK_THROWS_WITH(bad.validate(), Catch::Contains("leaf_width"));
+  bad = s;
+  bad.added_mass_coefficient = 2.5;
+  CHECK_THROWS_WITH(bad.validate(), Catch::Contains("added_mass_coefficient") && Catch::Contains("[0, 2]"));
+  bad = s;
+  bad.drag_coefficient = -1;
+  CHECK_THROWS_WITH(bad.validate(), Catch::Contains("drag_coefficient"));
+  bad = s;
+  bad.blade = scenes::BladeModel::rod;
+  System other(scenes::wave_flume_domain(g), Tait<double>(1000, g.sound_speed()));
+  const auto other_layout = scenes::build_posidonia_flume(other, bad);
+  CHECK_THROWS_WITH(scenes::add_posidonia_drag_blades(other, bad, other_layout),
+                    Catch::Contains("not BladeModel::drag"));
 }

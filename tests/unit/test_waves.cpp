@@ -76,6 +76,25 @@ TEST_CASE("dispersion relation: residual and limits at all depths", "[waves]") {
   CHECK_THROWS_AS(waves::wave_number(1.0, -1.0), InputError);
 }
 
+TEST_CASE("canopy orbital velocity: the depth average of Airy's u amplitude over the canopy", "[waves]") {
+  // (1 / l) Int_0^l (H / 2) omega cosh(k z) / sinh(k h) dz by Simpson's rule against the closed form
+  const auto w = waves::linear_wave(1.2, 0.2);
+  const double H = 0.03;
+  for (double l : {1e-9, 0.02, 0.08, 0.2}) {
+    const int n = 2000;
+    double sum = 0;
+    for (int i = 0; i <= n; ++i) {
+      const double z = l * i / n, weight = (i == 0 || i == n) ? 1 : (i % 2 ? 4 : 2);
+      sum += weight * 0.5 * H * w.angular_frequency * std::cosh(w.wave_number * z) / std::sinh(w.kh());
+    }
+    CHECK_THAT(w.canopy_orbital_velocity(H, l), WithinRel(sum / (3 * n), 1e-10));
+  }
+  // the full depth: (H / 2) omega / (k h), the depth-mean velocity amplitude (volume flux / h)
+  CHECK_THAT(w.canopy_orbital_velocity(H, 0.2), WithinRel(0.5 * H * w.angular_frequency / w.kh(), 1e-12));
+  CHECK_THROWS_AS(w.canopy_orbital_velocity(H, 0.3), InputError);
+  CHECK_THROWS_AS(w.canopy_orbital_velocity(H, -0.01), InputError);
+}
+
 TEST_CASE("Biesel transfer functions: closed forms against the quadrature of Biesel's integral, and limits",
           "[waves]") {
   for (double kh : {0.05, 0.3, 0.593, 1.0, 2.0, 4.0}) {

@@ -27,11 +27,21 @@
 //   rod:        the real blade itself (t = 0.1 mm, E, rho), one line of rod nodes (solid/elastic_rod.hpp) per plant
 //               from the bed to l, clamped at the bed, pushed on both faces by the repulsive force
 //               (scenes/meadow.hpp): bending stiffness E t^3 / 12 and mass rho t per unit width exactly (issue 5.4),
-//               no fluid left out (the blade is a line between two fluid columns). The default.
+//               no fluid left out (the blade is a line between two fluid columns). At H = 0.03 m it falls over
+//               after about 7 s (docs/posidonia.md).
+//   drag:       the same real rods, porous (coupling/blade_drag.hpp): Posidonia grows in tufts, which a 2D model
+//               cannot resolve (the paper's Results); a 2D plant stands for a row of shoots across the flume whose
+//               leaves (width `leaf_width`, about 1 cm) cover its width, the water flows between them, and each rod
+//               node exchanges the Morison drag (1/2) rho C_D |u_n| u_n per unit frontal area with the fluid. Plants
+//               `spacing` apart are a meadow of frontal area a = 1 / spacing per unit bed area (N b = a leaves of
+//               width b per m^2: scenes/meadow.hpp). C_D from the plate law for oscillatory flow at the incident
+//               wave's Keulegan-Carpenter number over the blade height (Luhar & Nepf 2016), unless given. The rods
+//               carry the plate's added inertia C_M rho_w pi b / 4. The default.
 // In 2D scaled and equivalent are plane strain: the bending stiffness per unit width is E_m t_m^3 / (12 (1 - nu_m^2));
 // the rod bends as a beam with E (a seagrass blade is narrow).
 #pragma once
 
+#include <sphfsi/analysis/vegetation_drag.hpp>
 #include <sphfsi/core/error.hpp>
 #include <sphfsi/core/particle_system.hpp>
 #include <sphfsi/scenes/builders.hpp>
@@ -45,7 +55,7 @@
 
 namespace sphfsi::scenes {
 
-enum class BladeModel { equivalent, scaled, rod };
+enum class BladeModel { equivalent, scaled, rod, drag };
 
 /// The Posidonia flume: waves, resolution, plants and blade model (lengths in m).
 template <Real T>
@@ -62,13 +72,13 @@ struct PosidoniaFlume {
   T damping_rate{T(10)};                                  ///< beta, 1/s
   std::vector<T> gauges{T(0.6), T(1.0), T(1.3), T(1.7)};  ///< gauge positions, m
   // plants
-  int plants{1};                      ///< number of plants (0: the empty flume)
-  T first_plant_x{T(1.2)};            ///< centre line of the first (upstream) plant, m
-  T spacing{T(0.1)};                  ///< distance between neighbouring plants, m
-  T height_ratio{T(0.4)};             ///< blade length / depth, [0.1, 0.9] (paper: 0.32 to 0.5)
-  BladeModel blade{BladeModel::rod};  ///< rod: the real blade (the equivalent continuum does not run)
-  int blade_rows{3};                  ///< particle rows across the blade (>= 3: the normal needs them)
-  int clamp_rows{3};                  ///< rows embedded below the bed (the reflection clamp's images)
+  int plants{1};                       ///< number of plants (0: the empty flume)
+  T first_plant_x{T(1.2)};             ///< centre line of the first (upstream) plant, m
+  T spacing{T(0.1)};                   ///< distance between neighbouring plants, m
+  T height_ratio{T(0.4)};              ///< blade length / depth, [0.1, 0.9] (paper: 0.32 to 0.5)
+  BladeModel blade{BladeModel::drag};  ///< drag: the real blade, porous (the equivalent continuum does not run)
+  int blade_rows{3};                   ///< particle rows across the blade (>= 3: the normal needs them)
+  int clamp_rows{3};                   ///< rows embedded below the bed (the reflection clamp's images)
   // the real blade (Table 3)
   T real_density{T(910)};             ///< kg/m^3
   T real_youngs_modulus{T(4.7e8)};    ///< Pa
@@ -81,6 +91,10 @@ struct PosidoniaFlume {
   bool rod_velocity_factor{false};    ///< rod blade: eq. 23's velocity factor in the coupling
   T rod_normal_damping{T(0.5)};       ///< rod blade: beta of the coupling's normal dashpot (rate beta c0 / h)
   T rod_repulsion{T(0)};              ///< rod blade: k of eq. 19 (0: to stop 3 x the surface orbital velocity)
+  T leaf_width{T(0.01)};              ///< drag blade: width b of one Posidonia leaf, m (added inertia, KC)
+  T drag_coefficient{T(0)};           ///< drag blade: C_D (0: the plate law at the incident wave's KC)
+  T friction_coefficient{T(0)};       ///< drag blade: C_f of the tangential skin friction
+  T added_mass_coefficient{T(1)};     ///< drag blade: C_M of the plate's added inertia C_M rho_w pi b / 4
 
   void validate() const {
     require_positive("PosidoniaFlume::depth (m)", depth);
@@ -94,36 +108,42 @@ struct PosidoniaFlume {
     require_positive("PosidoniaFlume::real_thickness (m)", real_thickness);
     require_in_open_range("PosidoniaFlume::poisson_ratio", poisson_ratio, T(-1), T(0.5));
     require_positive("PosidoniaFlume::equivalent_bulk_modulus (Pa)", equivalent_bulk_modulus);
+    require_positive("PosidoniaFlume::leaf_width (b, m)", leaf_width);
+    require_non_negative("PosidoniaFlume::drag_coefficient (C_D; 0: from KC)", drag_coefficient);
+    require_non_negative("PosidoniaFlume::friction_coefficient (C_f)", friction_coefficient);
+    require_in_range("PosidoniaFlume::added_mass_coefficient (C_M)", added_mass_coefficient, T(0), T(2));
     if (!gauges.empty())
       for (T x : gauges) require_in_range("PosidoniaFlume gauge position (m)", x, T(0), absorber_start);
     if (plants > 0) {
-      if (blade != BladeModel::rod && blade_length_rows() < clamp_rows)
+      if (!thin_blade() && blade_length_rows() < clamp_rows)
         throw InputError(
             fmt::format("PosidoniaFlume: the blade has {} rows above the bed (height_ratio {} at h/dp = "
                         "{}), fewer than the {} embedded rows it must mirror: raise height_ratio or h/dp",
                         blade_length_rows(), height_ratio, particles_per_depth, clamp_rows));
       require_in_range("PosidoniaFlume::first_plant_x (m)", first_plant_x, T(4) * dp(), absorber_start);
       const T last = first_plant_x + T(plants - 1) * spacing;
-      if (plants > 1 && blade != BladeModel::rod)
+      if (plants > 1 && !thin_blade())
         require_in_range("PosidoniaFlume::spacing (m, plants' reference supports must not overlap)", spacing,
                          blade_thickness() + T(3) * dp(), T(10) * depth);
-      if (plants > 1 && blade == BladeModel::rod)
-        require_in_range("PosidoniaFlume::spacing (m, at least two fluid columns between rod blades)", spacing,
+      if (plants > 1 && thin_blade())
+        require_in_range("PosidoniaFlume::spacing (m, at least two fluid columns between thin blades)", spacing,
                          T(2) * dp(), T(10) * depth);
       require_in_range("PosidoniaFlume last plant x (m)", last, first_plant_x, absorber_start);
     }
   }
 
   T dp() const { return depth / particles_per_depth; }
-  /// t_m, m (the rod: the real thickness)
-  T blade_thickness() const { return blade == BladeModel::rod ? real_thickness : T(blade_rows) * dp(); }
+  /// The real blade as a line of rod nodes (rod, drag), not a continuum of particle rows (scaled, equivalent).
+  bool thin_blade() const { return blade == BladeModel::rod || blade == BladeModel::drag; }
+  /// t_m, m (the rods: the real thickness)
+  T blade_thickness() const { return thin_blade() ? real_thickness : T(blade_rows) * dp(); }
   int blade_length_rows() const { return std::max(1, int(std::lround(height_ratio * depth / dp()))); }
   T blade_length() const { return T(blade_length_rows()) * dp(); }  ///< l (rounded to whole rows), m
   /// Centre line of each plant, snapped to the fluid lattice ((i + 1/2) dp) shifted by dp/2 for even row counts;
   /// a rod blade stands on a lattice line i dp, between two fluid columns.
   std::vector<T> plant_x() const {
     std::vector<T> x;
-    const T d = dp(), shift = blade_rows % 2 == 0 || blade == BladeModel::rod ? T(0.5) * d : T(0);
+    const T d = dp(), shift = blade_rows % 2 == 0 || thin_blade() ? T(0.5) * d : T(0);
     for (int i = 0; i < plants; ++i) {
       const T want = first_plant_x + T(i) * spacing;
       x.push_back((std::floor((want - shift) / d) + T(0.5)) * d + shift);
@@ -135,7 +155,7 @@ struct PosidoniaFlume {
   ElasticMaterial<T> real_material() const { return {real_density, real_youngs_modulus, poisson_ratio}; }
   /// The modelled blade's material at thickness t_m (see the header comment; the rod: the real material).
   ElasticMaterial<T> blade_material() const {
-    if (blade == BladeModel::rod) return real_material();
+    if (thin_blade()) return real_material();
     const T ratio = real_thickness / blade_thickness();  // t / t_m
     if (blade == BladeModel::scaled) return {real_density, real_youngs_modulus * ratio, poisson_ratio};
     const T E = real_youngs_modulus * ratio * ratio * ratio;
@@ -146,7 +166,7 @@ struct PosidoniaFlume {
   /// Bending stiffness per unit width of the model blade in plane strain, E_m t_m^3 / (12 (1 - nu_m^2)), N m; the
   /// rod: E t^3 / 12 (beam bending).
   T model_bending_stiffness() const {
-    if (blade == BladeModel::rod) return rod_blade().bending_stiffness_per_width();
+    if (thin_blade()) return rod_blade().bending_stiffness_per_width();
     const auto m = blade_material();
     const T t = blade_thickness();
     return m.plane_strain_modulus() * t * t * t / T(12);
@@ -154,6 +174,20 @@ struct PosidoniaFlume {
   /// Bending stiffness per unit width of the real blade, E t^3 / 12, N m.
   T real_bending_stiffness() const {
     return real_youngs_modulus * real_thickness * real_thickness * real_thickness / T(12);
+  }
+
+  /// Keulegan-Carpenter number of the incident wave over the blade height, U_m T / b, with U_m the linear orbital
+  /// velocity amplitude averaged from the bed to the blade length (waves/linear_theory.hpp) and b the leaf width.
+  T keulegan_carpenter_number() const {
+    const auto w = waves::linear_wave(period, depth);
+    return analysis::keulegan_carpenter_number(w.canopy_orbital_velocity(wave_height, blade_length()), period,
+                                               leaf_width);
+  }
+  /// The drag blade's C_D: drag_coefficient if given, else max(10 KC^(-1/3), 1.95) at keulegan_carpenter_number()
+  /// (Luhar & Nepf 2016, analysis/vegetation_drag.hpp).
+  T blade_drag_coefficient() const {
+    return drag_coefficient > T(0) ? drag_coefficient
+                                   : analysis::oscillatory_plate_drag_coefficient(keulegan_carpenter_number());
   }
 
   /// The real blade as a rod of length l (the same whole rows of dp as the continuum blades), clamped at the bed.
@@ -185,7 +219,7 @@ struct PosidoniaFlume {
     g.damping_rate = damping_rate;
     g.absorber = FlumeAbsorber::damping_zone;
     const T half = T(0.5) * blade_thickness(), top = blade_length();
-    if (blade != BladeModel::rod)
+    if (!thin_blade())
       for (T x : plant_x()) g.fluid_exclusions.push_back({Vec<2, T>(x - half, T(0)), Vec<2, T>(x + half, top)});
     return g;
   }
@@ -203,7 +237,8 @@ struct PosidoniaLayout {
 
 /// Fills `system` (empty, on wave_flume_domain(scene.flume())) with the flume and the plants (solid body
 /// plant_body). The caller creates the solid model and clamps it with clamp_by_reflection(0, +z) on the bed.
-/// For BladeModel::rod only the flume is built (and plant_x set): add the blades with add_posidonia_rods.
+/// For the rods (BladeModel::rod, drag) only the flume is built (and plant_x set): add the blades with
+/// add_posidonia_rods or add_posidonia_drag_blades.
 template <class System>
 PosidoniaLayout<typename System::scalar_type> build_posidonia_flume(
     System& system, const PosidoniaFlume<typename System::scalar_type>& scene) {
@@ -218,7 +253,7 @@ PosidoniaLayout<typename System::scalar_type> build_posidonia_flume(
   const Resolution<T> res{dp, g.smoothing_ratio};
   const auto material = scene.blade_material();
   const T mass = material.density * dp * dp;
-  if (scene.blade == BladeModel::rod) return out;
+  if (scene.thin_blade()) return out;
   for (T xc : out.plant_x) {
     std::vector<std::uint32_t> tip;
     // the blade (z in (0, l)) and its embedded image rows (z in (-clamp_rows dp, 0)), one lattice
@@ -251,6 +286,27 @@ RodBlades<System> add_posidonia_rods(System& system, const PosidoniaFlume<typena
     throw InputError("add_posidonia_rods: the scene's blade model is not BladeModel::rod");
   return add_rod_blades(system, layout.plant_x, T(0), scene.rod_blade(), scene.dp(), g.smoothing_ratio * scene.dp(),
                         layout.plant_body, how);
+}
+
+/// The porous rod plants (BladeModel::drag) of a flume built by build_posidonia_flume (bodies plant_body, ...),
+/// clamped at the bed: each node exchanges its Morison drag with the fluid (coupling/blade_drag.hpp) with C_D =
+/// scene.blade_drag_coefficient(), C_f and the leaf's added inertia from the scene; `how` sets the rest.
+template <class System>
+RodBlades<System, BladeDrag<typename System::scalar_type>> add_posidonia_drag_blades(
+    System& system, const PosidoniaFlume<typename System::scalar_type>& scene,
+    const PosidoniaLayout<typename System::scalar_type>& layout,
+    DragBladeCoupling<typename System::scalar_type> how = {}) {
+  using T = typename System::scalar_type;
+  if (scene.blade != BladeModel::drag)
+    throw InputError("add_posidonia_drag_blades: the scene's blade model is not BladeModel::drag");
+  const WaveFlumeGeometry<T> g = scene.flume();
+  how.coupling.drag_coefficient = scene.blade_drag_coefficient();
+  how.coupling.friction_coefficient = scene.friction_coefficient;
+  how.blade_width = scene.leaf_width;
+  how.added_mass_coefficient = scene.added_mass_coefficient;
+  how.gravity = g.wave.gravity;
+  return add_drag_blades(system, layout.plant_x, T(0), scene.rod_blade(), scene.dp(), g.smoothing_ratio * scene.dp(),
+                         layout.plant_body, how);
 }
 
 }  // namespace sphfsi::scenes

@@ -35,6 +35,15 @@ struct LinearWave {
   /// Amplitude of the horizontal orbital velocity at the still-water surface for a wave of height H (m):
   /// (H / 2) omega / tanh(k h), m/s (Dean & Dalrymple 1991, sec. 4.4).
   T surface_orbital_velocity(T height) const { return T(0.5) * height * angular_frequency / std::tanh(kh()); }
+  /// Amplitude of the horizontal orbital velocity averaged over the lowest `canopy_height` (m) of the water column,
+  /// (H / 2) omega (1 / l) Int_0^l cosh(k z) dz / sinh(k h) = (H / 2) omega sinh(k l) / (k l sinh(k h)), z above the
+  /// bed (the velocity scale of a canopy of height l, e.g. its Keulegan-Carpenter number), m/s.
+  T canopy_orbital_velocity(T height, T canopy_height) const {
+    require_in_range("LinearWave::canopy_orbital_velocity canopy height (m)", canopy_height, T(0), depth);
+    const T kl = wave_number * canopy_height;
+    const T shape = kl > T(1e-6) ? std::sinh(kl) / kl : T(1);
+    return T(0.5) * height * angular_frequency * shape / std::sinh(kh());
+  }
 };
 
 /// Solves omega^2 = g k tanh(k h) for k by Newton's method on F(x) = x tanh x - omega^2 h / g, x = k h, from
