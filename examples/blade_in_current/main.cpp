@@ -55,6 +55,7 @@ struct Options {
   T density = 950;               // rho_s, kg/m^3 (neutral buoyancy does not matter: g = 0)
   T speed = 0.2;                 // U, m/s
   T particles_along = 15;        // l / dp
+  T rod_spacing = 0.5;           // rod node spacing / dp
   T nominal_drag = 2.0;          // C_D used to choose E for a target Ca (the measured one is reported)
   T tow_lengths = 8;             // towing distance after the ramp, in blade lengths
   bool velocity_factor = false;  // eps(u_perp) of eq. 23: off, it rectifies the jitter of a light blade
@@ -64,7 +65,10 @@ struct Options {
   // the fluid (coupling/blade_drag.hpp), the drag law of Luhar & Nepf's model itself: a check of the rod and of the
   // fluid's response, not of the flow around the blade
   std::string coupling = "repulsive";
-  T blade_cd = 1.95;         // C_D of the drag coupling
+  T blade_cd = 1.95;  // C_D of the drag coupling
+  // drag coupling: share phi of the 2D channel's width the blade covers (b / W of one blade in a flume of width W;
+  // 1: a full-width row of blades, whose drag slows the whole 2D stream through it; coupling/blade_drag.hpp)
+  T frontal_fraction = 1;
   bool global_step = false;  // true: the fluid steps with the rod's own stable step (no sub-cycling)
   T end_time = 0;            // s; 0: the ramp and the whole towing distance
   T depth_lengths = 3;       // channel depth in blade lengths (blockage l / depth)
@@ -99,8 +103,8 @@ CaseResult run_case(const Options& o, T target_ca) {
   for_each_lattice_point<2, T>(V(-3 * dp, depth), V(tank + 3 * dp, depth + 3 * dp), dp, [&](const V& x) {
     system.particles().add(Kind::wall, x, V::Zero(), rho, rho * dp * dp, res.h(), 0);  // the lid
   });
-  // The blade on a lattice line (fluid columns at dp/2 on either side), nodes at dp/2.
-  const int nodes = static_cast<int>(std::lround(2 * o.particles_along)) + 1;
+  // The blade on a lattice line (fluid columns at dp/2 on either side), nodes every rod_spacing dp (dp/2).
+  const int nodes = static_cast<int>(std::lround(o.particles_along / o.rod_spacing)) + 1;
   ElasticMaterial<T> material;
   material.density = o.density;
   material.poisson_ratio = T(0.4);
@@ -118,8 +122,9 @@ CaseResult run_case(const Options& o, T target_ca) {
   if constexpr (porous) params.added_mass_per_area = plate_added_mass_per_area(rho, section.width);
   Rod rod(system, 1, material, params);
   // A blade folding over rests one fluid spacing above the bed: the fluid trapped under it keeps a row of room
-  // (at dp / 2 the first fluid row was crushed between the bed and the blade, a blow-up at Ca = 390).
-  rod.set_contact_plane(V(0, 0), V(0, 1), dp);
+  // (at dp / 2 the first fluid row was crushed between the bed and the blade, a blow-up at Ca = 390). A porous
+  // blade traps no fluid: its contact plane is the bed itself (a gap g would hold its lowest g upright).
+  rod.set_contact_plane(V(0, 0), V(0, 1), porous ? T(0) : dp);
   if (target_ca > 0) rod.clamp_base();
   else rod.clamp_where([](const V&) { return true; });  // the rigid reference blade
   // Towing: velocity U (1 - cos(pi t / ramp)) / 2 during the ramp, U after it.
@@ -136,6 +141,7 @@ CaseResult run_case(const Options& o, T target_ca) {
   Coupling coupling;
   if constexpr (porous) {
     coupling.drag_coefficient = o.blade_cd;
+    coupling.frontal_fraction = o.frontal_fraction;
   } else {  // eq. 19 with k = 0.01: no hydrostatic load to balance here
     coupling.velocity_factor = o.velocity_factor;
     coupling.normal_damping = o.normal_damping;
@@ -204,6 +210,7 @@ int main(int argc, char** argv) try {
   o.length = cli.get_number("length", o.length, "blade length l, m");
   o.thickness = cli.get_number("thickness", o.thickness, "blade thickness t, m");
   o.particles_along = cli.get_number("resolution", o.particles_along, "fluid particles along the blade, l / dp");
+  o.rod_spacing = cli.get_number("rod-spacing", o.rod_spacing, "rod node spacing / dp, [0.05, 2]");
   o.tow_lengths = cli.get_number("tow-lengths", o.tow_lengths, "towing distance after the ramp, blade lengths");
   o.velocity_factor = cli.get_switch("velocity-factor", false, "eps(u_perp) of eq. 23 in the blade coupling: on | off");
   o.normal_damping =
@@ -212,6 +219,9 @@ int main(int argc, char** argv) try {
                        "blade coupling: repulsive (the blade an obstacle, eqs 17-23) | drag (porous: its Morison drag "
                        "with --blade-cd, the model's own drag law)");
   o.blade_cd = cli.get_number("blade-cd", o.blade_cd, "C_D of --coupling drag");
+  o.frontal_fraction = cli.get_number(
+      "frontal-fraction", o.frontal_fraction,
+      "--coupling drag: share phi of the channel's width the blade covers (b / W; 1: a full-width row), (0, 1]");
   o.visibility = cli.get_switch("visibility", true,
                                 "on: fluid pairs across the blade do not interact (visibility criterion) | off");
   o.global_step =
@@ -230,6 +240,7 @@ int main(int argc, char** argv) try {
   require_positive("--length (m)", o.length);
   require_positive("--thickness (m)", o.thickness);
   require_in_range("--resolution (l / dp)", o.particles_along, T(5), T(200));
+  require_in_range("--rod-spacing (ds / dp)", o.rod_spacing, T(0.05), T(2));
   require_in_range("--depth (blade lengths)", o.depth_lengths, T(1.5), T(20));
   require_in_range("--average-from (blade lengths)", o.average_from, T(0), o.tow_lengths - T(1));
   o.cauchy.clear();

@@ -27,7 +27,7 @@ empty = None
 if args and args[0] == "--empty":
     empty = read(os.path.join(args[1], "empty", "wave_heights.csv"))
     args = args[2:]
-runs = [a.split("=", 1) for a in args]
+runs = [a.rsplit("=", 1) for a in args]  # the folder after the last "="
 fig, (ax, bx, cx) = plt.subplots(1, 3, figsize=(15, 4))
 width = 0.8 / len(runs)
 for k, (label, folder) in enumerate(runs):

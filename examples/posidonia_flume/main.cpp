@@ -90,6 +90,7 @@ scenes::PosidoniaFlume<T> converted(const scenes::PosidoniaFlume<double>& s) {
   c.rod_repulsion = T(s.rod_repulsion);
   c.leaf_width = T(s.leaf_width), c.drag_coefficient = T(s.drag_coefficient);
   c.friction_coefficient = T(s.friction_coefficient), c.added_mass_coefficient = T(s.added_mass_coefficient);
+  c.frontal_fraction = T(s.frontal_fraction);
   return c;
 }
 
@@ -351,10 +352,11 @@ int run(const Options& o) {
   if (scene.blade == scenes::BladeModel::drag) {
     const T a = T(1) / scene.spacing;
     fmt::print(
-        "porous blades: each plant a row of leaves b = {} m wide across the flume; C_D = {:.3f} ({}), C_f = {}, "
+        "porous blades: each plant a row of leaves b = {} m wide covering {} of the flume's width; C_D = {:.3f} ({}), "
+        "C_f = {}, "
         "added inertia C_M rho_w pi b / 4 = {:.3g} kg/m^2 (C_M = {}); KC of the incident wave over the blade height "
         "{:.1f}{}\n",
-        double(scene.leaf_width), double(scene.blade_drag_coefficient()),
+        double(scene.leaf_width), double(scene.frontal_fraction), double(scene.blade_drag_coefficient()),
         scene.drag_coefficient > T(0) ? "given" : "plate law at the incident KC", double(scene.friction_coefficient),
         double(plate_added_mass_per_area(T(1000), scene.leaf_width, scene.added_mass_coefficient)),
         double(scene.added_mass_coefficient), double(scene.keulegan_carpenter_number()),
@@ -477,6 +479,8 @@ int main(int argc, char** argv) try {
   s.friction_coefficient = cli.get_number("blade-cf", 0, "drag blade: C_f of the tangential skin friction");
   s.added_mass_coefficient =
       cli.get_number("added-mass-coefficient", 1, "drag blade: C_M of the leaf's added inertia C_M rho_w pi b / 4");
+  s.frontal_fraction = cli.get_number(
+      "frontal-fraction", 1, "drag blade: share of the flume's width one plant's leaves cover (1: a full row), (0, 1]");
   s.poisson_ratio = cli.get_number("poisson", 0.3, "Poisson ratio of the real and scaled blade");
   s.real_density = cli.get_number("real-density", 910, "density of the real blade, kg/m^3");
   s.real_youngs_modulus = cli.get_number("real-modulus", 4.7e8, "Young's modulus of the real blade, Pa");

@@ -411,6 +411,18 @@ TEST_CASE("blade drag: the Morison force of a uniform stream on an inclined blad
     CHECK(power <= 1e-12 * magnitude);
     CHECK(power < 0);
   }
+
+  // A blade covering a share phi of the scene's width: the node's force unchanged, the fluid feels phi of it, so
+  // phi sum_nodes m a + sum_fluid m a = 0 (the rod counted per unit width of the scene).
+  BladeDrag<double> sparse = drag;
+  sparse.frontal_fraction = 0.25;
+  for (std::size_t i = 0; i < p.size(); ++i) p.velocity[i] = p.kind[i] == Kind::fluid ? V(U, 0) : V::Zero();
+  drag_only(system, sparse);
+  V node_force = V::Zero(), fluid_force = V::Zero();
+  for (std::size_t i = 0; i < p.size(); ++i)
+    (p.kind[i] == Kind::solid ? node_force : fluid_force) += p.mass[i] * p.acceleration[i];
+  CHECK((node_force - expected).norm() <= 1e-12 * expected.norm());
+  CHECK((0.25 * node_force + fluid_force).norm() <= 1e-12 * expected.norm());
 }
 
 TEST_CASE("blade drag: nodes above the free surface exchange nothing; 30 coupled steps keep momentum",
@@ -453,4 +465,9 @@ TEST_CASE("blade drag: bad coefficients are rejected with the valid range", "[co
   drag.friction_coefficient = 0;
   drag.fluid_density = -1;
   CHECK_THROWS_WITH(drag.validate(), Catch::Contains("BladeDrag::fluid_density"));
+  drag.fluid_density = 0;
+  for (double phi : {0.0, -0.5, 1.5}) {
+    drag.frontal_fraction = phi;
+    CHECK_THROWS_WITH(drag.validate(), Catch::Contains("BladeDrag::frontal_fraction"));
+  }
 }

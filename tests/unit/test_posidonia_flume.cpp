@@ -390,6 +390,9 @@ TEST_CASE("posidonia drag plants: porous rows of real leaves, C_D from the incid
   bad.drag_coefficient = -1;
   CHECK_THROWS_WITH(bad.validate(), Catch::Contains("drag_coefficient"));
   bad = s;
+  bad.frontal_fraction = 0;
+  CHECK_THROWS_WITH(bad.validate(), Catch::Contains("frontal_fraction"));
+  bad = s;
   bad.blade = scenes::BladeModel::rod;
   System other(scenes::wave_flume_domain(g), Tait<double>(1000, g.sound_speed()));
   const auto other_layout = scenes::build_posidonia_flume(other, bad);

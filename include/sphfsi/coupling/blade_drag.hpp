@@ -11,14 +11,18 @@
 // with n, t the node's normal and tangent, u_n = u . n, u_t = u . t, and u_f(x_k) the fluid velocity at the node,
 // Shepard-interpolated from the fluid particles in its kernel support:
 //   u_f(x_k) = sum_f w_kf v_f,   w_kf = V_f W(x_k - x_f, h) / sum_g V_g W(x_k - x_g, h).
-// The node receives F_k / m_k; each fluid particle f receives -w_kf F_k / m_f, so the pair set conserves linear
-// momentum to round-off (sum_f w_kf = 1), and the power F_k . v_k - sum_f w_kf F_k . v_f = -F_k . u <= 0: the
-// coupling only dissipates. Morison et al. (1950) for the force form; its use for flexible blades resolved as beams
-// with the normal and tangential components above: Luhar & Nepf (2016, J. Fluids Struct. 61:20), who also include
-// the added-mass force (here the rod's added inertia, ElasticRodParameters::added_mass_per_area; the force of the
-// fluid's own acceleration is not included) and a Keulegan-Carpenter dependent C_D (analysis/vegetation_drag.hpp:
-// oscillatory_plate_drag_coefficient). A node with no fluid in its support (above the free surface) exchanges
-// nothing.
+// The node receives F_k / m_k; each fluid particle f receives -phi w_kf F_k / m_f, so the pair set conserves linear
+// momentum to round-off (sum_f w_kf = 1; the rod counted with the weight phi, below), and the power
+// phi (F_k . v_k - sum_f w_kf F_k . v_f) = -phi F_k . u <= 0: the coupling only dissipates.
+// phi = `frontal_fraction`, the share of the 2D scene's width that the blades it stands for cover: 1 for a full-width
+// row (a meadow at the equivalent spacing, scenes/meadow.hpp), b / W for a single blade of width b in a flume of
+// width W (blade_in_current). The rod's properties are per unit width of blade; per unit width of the scene the
+// blade has phi times its force, mass and momentum, and the fluid feels phi times its drag. Morison et al. (1950) for
+// the force form; its use for flexible blades resolved as beams with the normal and tangential components above: Luhar
+// & Nepf (2016, J. Fluids Struct. 61:20), who also include the added-mass force (here the rod's added inertia,
+// ElasticRodParameters::added_mass_per_area; the force of the fluid's own acceleration is not included) and a
+// Keulegan-Carpenter dependent C_D (analysis/vegetation_drag.hpp: oscillatory_plate_drag_coefficient). A node with no
+// fluid in its support (above the free surface) exchanges nothing.
 //
 // Limits: it needs a thin structure (one line of nodes with published normals, solid/elastic_rod.hpp). It does not
 // keep the fluid on one side of the blade (crossings are the point here), so it is not the coupling for a blade
@@ -56,11 +60,14 @@ struct BladeDrag {
   T friction_coefficient{T(0)};
   /// rho_w of the drag, kg/m^3; 0: the fluid EOS's reference density.
   T fluid_density{T(0)};
+  /// phi: share of the scene's width covered by the blades this 2D blade stands for (see the header), (0, 1].
+  T frontal_fraction{T(1)};
 
   void validate() const {
     require_in_range("BladeDrag::drag_coefficient (C_D)", drag_coefficient, T(0), T(10));
     require_in_range("BladeDrag::friction_coefficient (C_f)", friction_coefficient, T(0), T(1));
     require_non_negative("BladeDrag::fluid_density (kg/m^3)", fluid_density);
+    require_in_range("BladeDrag::frontal_fraction (phi)", frontal_fraction, std::numeric_limits<T>::min(), T(1));
   }
 
   /// The drag force per unit width on a blade element of length ds moving at relative velocity u = u_f - v_s
@@ -73,7 +80,7 @@ struct BladeDrag {
   }
 
   /// The drag is explicit: the relative velocity of node k and its fluid relaxes at about
-  /// lambda_k = (1/2) rho ds_k (C_D + C_f) |u_k| (r_k / m_k + sum_f w_kf^2 / m_f) (r_k: the share of a force on the
+  /// lambda_k = (1/2) rho ds_k (C_D + C_f) |u_k| (r_k / m_k + phi sum_f w_kf^2 / m_f) (r_k: the share of a force on the
   /// node that accelerates it, ElasticRod::inertia_ratios), stable for lambda dt < 2. Returns 2 / max_k lambda_k of
   /// the last evaluation's velocities (the Simulation applies its CFL factor); infinity while nothing moves.
   template <class System, class Solid>
@@ -90,7 +97,7 @@ struct BladeDrag {
       const std::size_t node = p.slot_of_id(ids[k]);
       const T speed = (s.fluid_velocity - p.velocity[node]).norm();
       const T rate = T(0.5) * rho * s.length * (drag_coefficient + friction_coefficient) * speed *
-                     (share / p.mass[node] + s.inverse_fluid_mass);
+                     (share / p.mass[node] + frontal_fraction * s.inverse_fluid_mass);
       if (rate > T(0)) dt = std::min(dt, T(2) / rate);
     }
     return dt;
@@ -122,7 +129,7 @@ struct BladeDrag {
       const std::size_t node = p.slot_of_id(ids[k]);
       const Vec<2, T> force = element_force(s.fluid_velocity - p.velocity[node], p.normal[node], s.length, rho);
       p.acceleration[node] += force / p.mass[node];
-      const Vec<2, T> per_weight = force / s.weight_sum;
+      const Vec<2, T> per_weight = (frontal_fraction / s.weight_sum) * force;
       system.for_each_neighbor(node, [&](std::size_t f, const Vec<2, T>&, T r, T h) {
         if (p.kind[f] != Kind::fluid) return;
         const T w = p.mass[f] / p.density[f] * kernel.value(r, h);

@@ -162,9 +162,11 @@ struct DragBladeCoupling {
   T added_mass_coefficient{T(1)};  ///< C_M, [0, 2]
   T ambient_density{T(1000)};      ///< rho_w for the blade's buoyancy and added inertia, kg/m^3
   T gravity{T(9.81)};              ///< m/s^2
-  T contact_gap_ratio{T(1)};       ///< the bed contact plane's gap over dp
-  T stretch_limit{T(1.5)};         ///< BlowUpError above this edge stretch
-  int load_smoothing_passes{0};    ///< passes of RodBlades' load filter (the interpolated drag is smooth: none)
+  /// The bed contact plane's gap over dp. 0 (the bed itself): the porous blade traps no fluid under it, and a gap g
+  /// would hold the lowest g of the blade upright (ElasticRod::set_contact_plane), >= 0.
+  T contact_gap_ratio{T(0)};
+  T stretch_limit{T(1.5)};       ///< BlowUpError above this edge stretch
+  int load_smoothing_passes{0};  ///< passes of RodBlades' load filter (the interpolated drag is smooth: none)
   /// Every node clamped: a rigid canopy, whose wave damping Dalrymple et al.'s (1984) formula gives from C_D alone
   /// (the check of the drag's energy budget in the flume, docs/meadow.md).
   bool rigid{false};
@@ -175,7 +177,7 @@ struct DragBladeCoupling {
     require_in_range("DragBladeCoupling::added_mass_coefficient (C_M)", added_mass_coefficient, T(0), T(2));
     require_positive("DragBladeCoupling::ambient_density (kg/m^3)", ambient_density);
     require_non_negative("DragBladeCoupling::gravity (m/s^2)", gravity);
-    require_positive("DragBladeCoupling::contact_gap_ratio", contact_gap_ratio);
+    require_non_negative("DragBladeCoupling::contact_gap_ratio", contact_gap_ratio);
     require_in_range("DragBladeCoupling::stretch_limit", stretch_limit, T(1), T(10));
   }
   /// Added inertia per unit length and width, C_M rho_w pi b / 4, kg/m^2.

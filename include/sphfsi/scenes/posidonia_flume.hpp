@@ -51,6 +51,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace sphfsi::scenes {
@@ -95,6 +96,9 @@ struct PosidoniaFlume {
   T drag_coefficient{T(0)};           ///< drag blade: C_D (0: the plate law at the incident wave's KC)
   T friction_coefficient{T(0)};       ///< drag blade: C_f of the tangential skin friction
   T added_mass_coefficient{T(1)};     ///< drag blade: C_M of the plate's added inertia C_M rho_w pi b / 4
+  /// drag blade: share phi of the flume's width the leaves of one plant cover (1: a full row; one shoot of n leaves
+  /// in a flume of width W: n b / W), (0, 1] (coupling/blade_drag.hpp)
+  T frontal_fraction{T(1)};
 
   void validate() const {
     require_positive("PosidoniaFlume::depth (m)", depth);
@@ -112,6 +116,7 @@ struct PosidoniaFlume {
     require_non_negative("PosidoniaFlume::drag_coefficient (C_D; 0: from KC)", drag_coefficient);
     require_non_negative("PosidoniaFlume::friction_coefficient (C_f)", friction_coefficient);
     require_in_range("PosidoniaFlume::added_mass_coefficient (C_M)", added_mass_coefficient, T(0), T(2));
+    require_in_range("PosidoniaFlume::frontal_fraction (phi)", frontal_fraction, std::numeric_limits<T>::min(), T(1));
     if (!gauges.empty())
       for (T x : gauges) require_in_range("PosidoniaFlume gauge position (m)", x, T(0), absorber_start);
     if (plants > 0) {
@@ -302,6 +307,7 @@ RodBlades<System, BladeDrag<typename System::scalar_type>> add_posidonia_drag_bl
   const WaveFlumeGeometry<T> g = scene.flume();
   how.coupling.drag_coefficient = scene.blade_drag_coefficient();
   how.coupling.friction_coefficient = scene.friction_coefficient;
+  how.coupling.frontal_fraction = scene.frontal_fraction;
   how.blade_width = scene.leaf_width;
   how.added_mass_coefficient = scene.added_mass_coefficient;
   how.gravity = g.wave.gravity;
