@@ -54,6 +54,7 @@ struct Options {
   double end_time{0};
   double snapshots{0};
   bool run_plants{true}, run_empty{true};
+  bool check{false};  // exit 4 unless every plant sways with the water beside it and stands (see --check)
   // Rod blades: fluid pairs across a blade do not interact (fluid/thin_structure_visibility.hpp).
   bool visibility{false};
   std::filesystem::path out;
@@ -65,6 +66,7 @@ struct CaseResult {
   std::vector<double> height, height_std, period;  // per gauge (NaN where no complete wave)
   std::vector<double> tip_dx_amplitude, tip_dz_amplitude, tip_dx_mean, tip_dz_mean;  // per plant, m
   std::vector<double> water_dx_amplitude, water_dx_mean;  // the water beside each tip, per plant, m
+  std::vector<double> tip_dz_lowest;                      // per plant, over the whole run, m
   std::size_t fluid{0}, wall{0}, solid{0}, steps{0}, solid_sub_steps{0}, fluid_inside_max{0}, crossings{0};
   double lowest_node{std::numeric_limits<double>::quiet_NaN()};  // rods: lowest free node above the bed, m
   double wall_seconds{0}, end_time{0}, reached{0}, max_stretch{1};
@@ -297,6 +299,7 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
     r.tip_dz_mean.push_back(n ? sum_z / double(n) : nan);
     r.water_dx_amplitude.push_back(n ? 0.5 * (hi_w - lo_w) : nan);
     r.water_dx_mean.push_back(n ? sum_w / double(n) : nan);
+    r.tip_dz_lowest.push_back(tip_dz[k].empty() ? nan : *std::min_element(tip_dz[k].begin(), tip_dz[k].end()));
   }
   return r;
 }
@@ -433,7 +436,27 @@ int run(const Options& o) {
   std::fflush(stdout);
   if (std::system(plot.c_str()) != 0) fmt::print("(plot skipped: /usr/bin/python3 with matplotlib not available)\n");
   const bool failed = (o.run_plants && !with.failure.empty()) || (o.run_empty && !without.failure.empty());
-  return failed ? 3 : 0;
+  if (failed) return 3;
+  if (o.check && o.run_plants) {
+    // A passive plant moves with the water: its tip excursion within a factor 2 of the water's beside it (a broken
+    // coupling leaves it still, a blade pushed by more than the flow outruns it), its mean lean within 0.3 l and its
+    // tip never below l / 4 under its upright height (the full-width rod blade leans 0.31 l and dips 0.58 l by 10 s,
+    // docs/posidonia.md).
+    const double l = double(scene.blade_length());
+    bool ok = true;
+    for (std::size_t k = 0; k < with.tip_dx_amplitude.size(); ++k) {
+      const double ratio = with.tip_dx_amplitude[k] / with.water_dx_amplitude[k];
+      const bool sways = ratio >= 0.5 && ratio <= 2,
+                 stands = std::abs(with.tip_dx_mean[k]) <= 0.3 * l && with.tip_dz_lowest[k] >= -0.25 * l;
+      fmt::print(
+          "check plant {}: tip / water excursion {:.2f} (valid [0.5, 2]), mean lean {:.3f} l (valid 0.3 l), "
+          "lowest tip dz {:.3f} l (valid -0.25 l): {}\n",
+          k, ratio, with.tip_dx_mean[k] / l, with.tip_dz_lowest[k] / l, sways && stands ? "ok" : "FAILED");
+      ok = ok && sways && stands;
+    }
+    if (!ok) return 4;
+  }
+  return 0;
 }
 
 int main(int argc, char** argv) try {
@@ -489,6 +512,9 @@ int main(int argc, char** argv) try {
   o.visibility = cli.get_switch("visibility", false,
                                 "rod blade: on: fluid pairs across the blade do not interact (the blade then holds "
                                 "each face's whole pressure: raise --repulsion) | off");
+  o.check = cli.get_switch("check", false,
+                           "on: exit 4 unless every plant sways with the water beside it (tip / water excursion in "
+                           "[0.5, 2]) and stands (mean lean within 0.3 l, tip never l / 4 below upright) | off");
   o.alpha = cli.get_number("alpha", 0.01, "artificial viscosity alpha");
   o.delta = cli.get_number("delta", 0.1, "delta-SPH coefficient");
   o.cfl = cli.get_number("cfl", 0.2, "CFL number of the fluid step (0, 1]");
