@@ -67,11 +67,30 @@ struct CaseResult {
   std::vector<double> tip_dx_amplitude, tip_dz_amplitude, tip_dx_mean, tip_dz_mean;  // per plant, m
   std::vector<double> water_dx_amplitude, water_dx_mean;  // the water beside each tip, per plant, m
   std::vector<double> tip_dz_lowest;                      // per plant, over the whole run, m
+  std::vector<double> current_mean;  // the Eulerian mean horizontal velocity at each plant's mid-height, m/s
   std::size_t fluid{0}, wall{0}, solid{0}, steps{0}, solid_sub_steps{0}, fluid_inside_max{0}, crossings{0};
   double lowest_node{std::numeric_limits<double>::quiet_NaN()};  // rods: lowest free node above the bed, m
   double wall_seconds{0}, end_time{0}, reached{0}, max_stretch{1};
   std::string failure;
 };
+
+/// Horizontal fluid velocity at x, Shepard-interpolated over the fluid particles whose kernel reaches it, m/s (0 if
+/// none does).
+template <class System>
+double eulerian_velocity(const System& system, const Vec<2, typename System::scalar_type>& x) {
+  using T = typename System::scalar_type;
+  const auto& p = system.particles();
+  const auto& kernel = system.kernel();
+  T sum_w = 0, sum_u = 0;
+  for (std::size_t f = 0; f < p.size(); ++f) {
+    if (p.kind[f] != Kind::fluid) continue;
+    const T r = (p.position[f] - x).norm(), h = p.smoothing_length[f];
+    if (r >= T(std::decay_t<decltype(kernel)>::support) * h) continue;
+    const T w = p.mass[f] / p.density[f] * kernel.value(r, h);
+    sum_w += w, sum_u += w * p.velocity[f][0];
+  }
+  return sum_w > T(0) ? double(sum_u / sum_w) : 0.0;
+}
 
 template <class T>
 scenes::PosidoniaFlume<T> converted(const scenes::PosidoniaFlume<double>& s) {
@@ -182,6 +201,9 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
     tip_columns.push_back(fmt::format("water_dx_{}", k));
     tip_columns.push_back(fmt::format("water_dz_{}", k));
   }
+  // the Eulerian current at each plant: the fluid's horizontal velocity, Shepard-interpolated at half the blade length
+  // above the base (the drag acts on it, where the tracers above follow the water's Lagrangian drift)
+  for (std::size_t k = 0; k < plant_count; ++k) tip_columns.push_back(fmt::format("u_mid_{}", k));
   std::optional<io::CsvWriter> tips_csv;
   if (WithPlants)
     tips_csv.emplace(dir / "tips.csv", tip_columns,
@@ -198,7 +220,7 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
   std::vector<scenes::FluidTracers<System>> water;
   for (std::size_t k = 0; k < plant_count; ++k) water.emplace_back(system, tip0[k], T(1.5) * scene.dp());
   std::vector<double> times;
-  std::vector<std::vector<double>> tip_dx(plant_count), tip_dz(plant_count), water_dx(plant_count);
+  std::vector<std::vector<double>> tip_dx(plant_count), tip_dz(plant_count), water_dx(plant_count), u_mid(plant_count);
   scenes::BladeCrossingCounter<System> crossings(T(1.5) * scene.dp());
 
   io::VtkSeriesWriter vtk(dir, "posidonia_flume");
@@ -226,6 +248,12 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
             row.push_back(double(w[0]));
             row.push_back(double(w[1]));
             water_dx[k].push_back(double(w[0]));
+          }
+          for (std::size_t k = 0; k < plant_count; ++k) {
+            const double u =
+                eulerian_velocity(sm.system(), Vec<2, T>(layout.plant_x[k], T(0.5) * scene.blade_length()));
+            row.push_back(u);
+            u_mid[k].push_back(u);
           }
           tips_csv->write_row(row);
           if constexpr (Rods) {
@@ -283,14 +311,14 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
     const double from =
         double(maker.ramp_time()) + double(layout.plant_x[k]) / double(wave.group_velocity) + double(wave.period);
     double lo_x = 1e9, hi_x = -1e9, lo_z = 1e9, hi_z = -1e9, sum_x = 0, sum_z = 0;
-    double lo_w = 1e9, hi_w = -1e9, sum_w = 0;
+    double lo_w = 1e9, hi_w = -1e9, sum_w = 0, sum_u = 0;
     std::size_t n = 0;
     for (std::size_t j = 0; j < times.size(); ++j) {
       if (times[j] < from) continue;
       lo_x = std::min(lo_x, tip_dx[k][j]), hi_x = std::max(hi_x, tip_dx[k][j]);
       lo_z = std::min(lo_z, tip_dz[k][j]), hi_z = std::max(hi_z, tip_dz[k][j]);
       lo_w = std::min(lo_w, water_dx[k][j]), hi_w = std::max(hi_w, water_dx[k][j]);
-      sum_x += tip_dx[k][j], sum_z += tip_dz[k][j], sum_w += water_dx[k][j], ++n;
+      sum_x += tip_dx[k][j], sum_z += tip_dz[k][j], sum_w += water_dx[k][j], sum_u += u_mid[k][j], ++n;
     }
     const double nan = std::numeric_limits<double>::quiet_NaN();
     r.tip_dx_amplitude.push_back(n ? 0.5 * (hi_x - lo_x) : nan);
@@ -299,6 +327,7 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
     r.tip_dz_mean.push_back(n ? sum_z / double(n) : nan);
     r.water_dx_amplitude.push_back(n ? 0.5 * (hi_w - lo_w) : nan);
     r.water_dx_mean.push_back(n ? sum_w / double(n) : nan);
+    r.current_mean.push_back(n ? sum_u / double(n) : nan);
     r.tip_dz_lowest.push_back(tip_dz[k].empty() ? nan : *std::min_element(tip_dz[k].begin(), tip_dz[k].end()));
   }
   return r;
@@ -404,10 +433,12 @@ int run(const Options& o) {
       fmt::print("  plant {} at x = {:.3f} m: |dx| {:.2f} mm, |dz| {:.2f} mm; mean dx {:+.2f} mm, dz {:+.2f} mm\n", k,
                  double(scene.plant_x()[k]), 1e3 * with.tip_dx_amplitude[k], 1e3 * with.tip_dz_amplitude[k],
                  1e3 * with.tip_dx_mean[k], 1e3 * with.tip_dz_mean[k]);
-    fmt::print("the water beside each tip (fluid particles that started within 1.5 dp of it):\n");
+    fmt::print(
+        "the water beside each tip (fluid particles that started within 1.5 dp of it) and the Eulerian mean current "
+        "at the plant's mid-height:\n");
     for (std::size_t k = 0; k < with.water_dx_amplitude.size(); ++k)
-      fmt::print("  plant {}: |dx| {:.2f} mm, mean dx {:+.2f} mm\n", k, 1e3 * with.water_dx_amplitude[k],
-                 1e3 * with.water_dx_mean[k]);
+      fmt::print("  plant {}: |dx| {:.2f} mm, mean dx {:+.2f} mm; mean current {:+.2f} mm/s\n", k,
+                 1e3 * with.water_dx_amplitude[k], 1e3 * with.water_dx_mean[k], 1e3 * with.current_mean[k]);
     fmt::print(
         "plants run: {} + {} + {} particles, {} steps, {} solid sub-steps, {:.1f} s wall; max stretch {:.3f}, "
         "fluid particles inside the blades (max) {}; fluid particles that crossed a rod blade {}; lowest rod node "
