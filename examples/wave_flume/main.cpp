@@ -14,6 +14,7 @@
 // (waves/second_order.hpp). Each gauge's height is also compared with second-order theory for the paddle signal used
 // (the beating included for --order 1). See docs/flume.md.
 #include <sphfsi/analysis/line_fit.hpp>
+#include <sphfsi/analysis/wave_reflection.hpp>
 #include <sphfsi/analysis/zero_crossing.hpp>
 #include <sphfsi/eos/tait.hpp>
 #include <sphfsi/integrators/simulation.hpp>
@@ -29,6 +30,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -50,6 +52,7 @@ struct Options {
   double height_tolerance{0.05};
   double decay_tolerance{0.02};
   double period_tolerance{0.01};
+  bool reflection{false};  // three more gauges in front of the absorber: incident and reflected waves separated
   std::filesystem::path out;
 };
 
@@ -90,9 +93,24 @@ int run(const Options& o) {
   sim.set_expected_flow_speed(wave.surface_orbital_velocity(g.wave.wave_height));  // for the c0 check
   const std::vector<T> gauge_x = scenes::wave_flume_gauges(g, o.gauges, T(o.gauge_spacing));
   const double x_last = double(gauge_x.back());
-  const double end_time = o.end_time > 0 ? o.end_time
-                                         : double(maker.ramp_time()) + x_last / double(wave.group_velocity) +
-                                               (o.waves_analysed + o.settle_periods + 0.5) * double(wave.period);
+  // Reflection array (--reflection on): gauges at x_r, x_r + L / 10, x_r + L / 4 with x_r half a wavelength before
+  // the absorber (the damping zone's entrance, or the beach toe), in the spacings Mansard & Funke (1980) recommend;
+  // analysed once the full-amplitude wave reflected by the absorber has settled there.
+  const double L = double(wave.wavelength), c_g = double(wave.group_velocity), Tw = double(wave.period);
+  const double absorber_x = g.has_damping_zone() ? double(g.damping_zone().x_start) : double(g.beach_toe());
+  const double x_r = absorber_x - 0.5 * L;
+  const std::vector<T> array_x{T(x_r), T(x_r + 0.1 * L), T(x_r + 0.25 * L)};
+  const double reflected_from = double(maker.ramp_time()) + (2 * absorber_x - x_r) / c_g + o.settle_periods * Tw;
+  const double reflected_to = reflected_from + o.waves_analysed * Tw;
+  double end_time = o.end_time > 0
+                        ? o.end_time
+                        : double(maker.ramp_time()) + x_last / c_g + (o.waves_analysed + o.settle_periods + 0.5) * Tw;
+  if (o.reflection && o.end_time <= 0) end_time = std::max(end_time, reflected_to + 0.25 * Tw);
+  if (o.reflection && x_r < 0.5 * L)
+    throw InputError(
+        fmt::format("--reflection on: the array at x = {:.3f} m is within half a wavelength of the "
+                    "paddle (valid: an absorber at least one wavelength, {:.3f} m, from the paddle)",
+                    x_r, L));
   fmt::print(
       "wave flume ({}): h = {:.4g} m, T = {:.5g} s, target H = {:.4g} m; kh = {:.3f}, L = {:.3f} m, c_g = {:.3f} m/s; "
       "{} "
@@ -120,16 +138,23 @@ int run(const Options& o) {
                   "target H = {:.4g} m, h/dp = {:.4g}",
                   double(g.depth()), double(g.wave.period), double(g.wave.wave_height), double(g.particles_per_depth)));
   io::CsvWriter paddle_csv(o.out / "paddle.csv", {"t", "X", "dXdt"});
+  waves::WaveGauges<T> array(array_x, layout.still_level, g.dp());
+  if (o.reflection)
+    array.open(o.out / "reflection_gauges.csv",
+               fmt::format("wave_flume: reflection array, eta (m) at x (m) = column suffix; absorber from x = {:.4f} m",
+                           absorber_x));
   io::VtkSeriesWriter vtk(o.out, "wave_flume");
   const double sample_every = double(g.wave.period) / 40;
   double next_sample = 0, next_snapshot = 0;
   io::ProgressReporter progress(end_time);
   const auto start = std::chrono::steady_clock::now();
   gauges.sample(system, T(0));
+  if (o.reflection) array.sample(system, T(0));
   sim.run(T(end_time), [&](Solver& sm) {
     progress(sm);
     if (double(sm.time()) >= next_sample) {
       gauges.sample(sm.system(), sm.time());
+      if (o.reflection) array.sample(sm.system(), sm.time());
       paddle_csv.write_row(
           {double(sm.time()), double(maker.displacement(sm.time())), double(maker.velocity(sm.time()))});
       next_sample += sample_every;
@@ -209,6 +234,27 @@ int run(const Options& o) {
       fmt::format("/usr/bin/python3 {}/examples/wave_flume/plot.py {}", SPHFSI_SOURCE_DIR, o.out.string());
   std::fflush(stdout);
   if (std::system(plot.c_str()) != 0) fmt::print("(plot skipped: /usr/bin/python3 with matplotlib not available)\n");
+  if (o.reflection) {  // Mansard & Funke (1980): incident and reflected amplitudes at the paddle's frequency
+    const std::vector<double> ta(array.times().begin(), array.times().end());
+    std::vector<std::vector<double>> eta(array_x.size());
+    std::vector<double> xa;
+    for (std::size_t i = 0; i < array_x.size(); ++i) {
+      eta[i].assign(array.series(i).begin(), array.series(i).end());
+      xa.push_back(double(array_x[i]));
+    }
+    const auto sep = analysis::separate_incident_reflected<double>(ta, eta, xa, double(wave.angular_frequency),
+                                                                   double(wave.wave_number), reflected_from,
+                                                                   std::min(reflected_to, ta.back()));
+    fmt::print(
+        "reflection (gauges at x = {:.3f}, {:.3f}, {:.3f} m, {:.2f}-{:.2f} s, Mansard & Funke 1980): incident "
+        "amplitude {:.5f} m, reflected {:.5f} m, K_r = {:.3f} (fit residual {:.3f} of the incident amplitude)\n",
+        xa[0], xa[1], xa[2], reflected_from, std::min(reflected_to, ta.back()), sep.incident_amplitude,
+        sep.reflected_amplitude, sep.reflection_coefficient, sep.residual);
+    io::CsvWriter csv(o.out / "reflection.csv",
+                      {"absorber_x", "from", "to", "incident_amplitude", "reflected_amplitude", "K_r", "residual"});
+    csv.write_row({absorber_x, reflected_from, std::min(reflected_to, ta.back()), sep.incident_amplitude,
+                   sep.reflected_amplitude, sep.reflection_coefficient, sep.residual});
+  }
   const double period_error = t_first / double(g.wave.period) - 1;
   const bool height_ok = h_first > 0 && std::abs(generated_error) <= o.height_tolerance;
   const bool period_ok = h_first > 0 && std::abs(period_error) <= o.period_tolerance;
@@ -266,6 +312,9 @@ int main(int argc, char** argv) try {
   o.height_tolerance = cli.get_number("height-tolerance", 0.05, "pass: |H(1 L) / H_target - 1| at most this");
   o.decay_tolerance = cli.get_number("decay-tolerance", 0.02, "pass: decay per wavelength at most this");
   o.period_tolerance = cli.get_number("period-tolerance", 0.01, "pass: |T(1 L) / T - 1| at most this");
+  o.reflection = cli.get_switch("reflection", false,
+                                "on: three gauges half a wavelength before the absorber separate the incident and "
+                                "reflected waves (Mansard & Funke 1980) and give the absorber's K_r | off");
   const std::string precision = cli.get("precision", "float", "scalar type: float | double");
   o.out = cli.get("output", "out/wave_flume", "output folder");
   if (!cli.finish()) return 0;

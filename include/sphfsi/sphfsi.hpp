@@ -5,6 +5,7 @@
 #include <sphfsi/analysis/elastica.hpp>
 #include <sphfsi/analysis/line_fit.hpp>
 #include <sphfsi/analysis/vegetation_drag.hpp>
+#include <sphfsi/analysis/wave_reflection.hpp>
 #include <sphfsi/analysis/zero_crossing.hpp>
 #include <sphfsi/boundary/repulsive_force.hpp>
 #include <sphfsi/core/domain.hpp>

@@ -2,6 +2,7 @@
 // analysis, the Dalrymple et al. (1984) decay fit and drag-coefficient inversion, the damping zone and the gauges.
 #include <sphfsi/analysis/line_fit.hpp>
 #include <sphfsi/analysis/vegetation_drag.hpp>
+#include <sphfsi/analysis/wave_reflection.hpp>
 #include <sphfsi/analysis/zero_crossing.hpp>
 #include <sphfsi/eos/tait.hpp>
 #include <sphfsi/kernel/wendland_c2.hpp>
@@ -429,4 +430,52 @@ TEST_CASE("oscillatory plate drag: C_D = max(10 KC^(-1/3), 1.95) of Luhar & Nepf
   CHECK_THAT(oscillatory_plate_drag_coefficient(1.0), Catch::Matchers::WithinRel(10.0, 1e-15));
   CHECK_THROWS_WITH(keulegan_carpenter_number(0.1, 1.4, 0.0), Catch::Contains("blade width b"));
   CHECK_THROWS_WITH(oscillatory_plate_drag_coefficient(-1.0), Catch::Contains("KC"));
+}
+
+TEST_CASE("incident and reflected waves: Mansard & Funke's least squares recovers a known reflection",
+          "[waves][analysis]") {
+  const double period = 1.4286, omega = 2 * pi / period, k = waves::linear_wave(period, 0.16).wave_number;
+  const double L = 2 * pi / k, a = 0.014, r = 0.0035;  // K_r = 0.25
+  const std::vector<double> x{3.0, 3.0 + L / 10, 3.0 + L / 4};
+  std::vector<double> t;
+  for (int j = 0; j < 40 * 6; ++j) t.push_back(10.0 + j * period / 40);  // 6 periods at T / 40
+  auto records = [&](double mean, double second_harmonic, double noise) {
+    std::mt19937 rng(3);
+    std::normal_distribution<double> n(0.0, 1.0);
+    std::vector<std::vector<double>> eta(x.size());
+    for (std::size_t i = 0; i < x.size(); ++i)
+      for (double tj : t)
+        eta[i].push_back(mean + a * std::cos(omega * tj - k * x[i] + 0.4) + r * std::cos(omega * tj + k * x[i] - 1.1) +
+                         second_harmonic * std::cos(2 * omega * tj - 2.3 * k * x[i]) + noise * n(rng));
+    return eta;
+  };
+  const double from = t.front(), to = t.front() + 6 * period - 1e-9;
+  // pure waves, a mean level and a second harmonic: exact over whole periods
+  const auto clean = analysis::separate_incident_reflected<double>(t, records(0.002, 0.003, 0), x, omega, k, from, to);
+  CHECK_THAT(clean.incident_amplitude, WithinRel(a, 1e-9));
+  CHECK_THAT(clean.reflected_amplitude, WithinRel(r, 1e-9));
+  CHECK_THAT(clean.reflection_coefficient, WithinRel(0.25, 1e-9));
+  CHECK(clean.residual < 1e-9);
+  CHECK(clean.samples == 240);
+  // noise of 10 % of a per sample: the amplitudes within a few standard errors, sigma sqrt(2 / N) per gauge
+  const auto noisy = analysis::separate_incident_reflected<double>(t, records(0, 0, 0.1 * a), x, omega, k, from, to);
+  CHECK(std::abs(noisy.reflection_coefficient - 0.25) < 0.03);
+  // a purely progressive wave has no reflection; two gauges suffice
+  const std::vector<double> two{x[0], x[1]};
+  std::vector<std::vector<double>> progressive(2);
+  for (std::size_t i = 0; i < 2; ++i)
+    for (double tj : t) progressive[i].push_back(a * std::cos(omega * tj - k * two[i]));
+  const auto none = analysis::separate_incident_reflected<double>(t, progressive, two, omega, k, from, to);
+  CHECK(none.reflection_coefficient < 1e-9);
+  CHECK_THAT(none.incident_amplitude, WithinRel(a, 1e-9));
+  // bad input: one gauge, gauges half a wavelength apart, a window shorter than a period
+  CHECK_THROWS_WITH(
+      analysis::separate_incident_reflected<double>(t, {progressive[0]}, std::vector<double>{x[0]}, omega, k, from, to),
+      Catch::Contains("at least two gauges"));
+  CHECK_THROWS_WITH(analysis::separate_incident_reflected<double>(
+                        t, progressive, std::vector<double>{x[0], x[0] + L / 2}, omega, k, from, to),
+                    Catch::Contains("half a wavelength"));
+  CHECK_THROWS_WITH(
+      analysis::separate_incident_reflected<double>(t, progressive, two, omega, k, from, from + 0.5 * period),
+      Catch::Contains("at least one period"));
 }
