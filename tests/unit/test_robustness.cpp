@@ -279,6 +279,19 @@ TEST_CASE("Robustness: every bad input of the public API is rejected, naming the
   bad.expect("elastica_tip_load alpha", [] { analysis::elastica_tip_load(T(0)); });
   bad.expect("AntociGate::solid_refinement", [] { scenes::AntociGate<T>{.solid_refinement = 3}.validate(); });
   bad.expect("AntociGate::smoothing_ratio", [] { scenes::AntociGate<T>{.smoothing_ratio = 0.5}.validate(); });
+  bad.expect("BladeDrag::frontal_fraction", [] { BladeDrag<T>{.frontal_fraction = 0}.validate(); });
+  bad.expect("BladeDrag::frontal_fraction", [] { BladeDrag<T>{.frontal_fraction = 1.5}.validate(); });
+  bad.expect("PosidoniaFlume::leaf_width", [] {
+    scenes::PosidoniaFlume<T> f;
+    f.leaf_width = -0.01;
+    f.validate();
+  });
+  bad.expect("LinearWave::canopy_orbital_velocity canopy height",
+             [] { waves::linear_wave(T(1.2), T(0.2)).canopy_orbital_velocity(T(0.03), T(0.5)); });
+  bad.expect("separate_incident_reflected: omega", [] {
+    const std::vector<T> t{0, 1}, x{0, 1};
+    analysis::separate_incident_reflected<T>(t, {{0, 0}, {0, 0}}, x, T(0), T(1), T(0), T(1));
+  });
   bad.expect("Simulation::set_expected_flow_speed", [] {
     System2 s(tank_domain, water);
     Simulation<System2, SymplecticVerlet>(s, FluidParameters<2, T>{}).set_expected_flow_speed(0);
@@ -289,7 +302,7 @@ TEST_CASE("Robustness: every bad input of the public API is rejected, naming the
   INFO(bad.report());
   CHECK(bad.failures.empty());
   CHECK(bad.rejected == bad.tried);
-  CHECK(bad.tried == 89 + 25);  // keeps the list from silently shrinking
+  CHECK(bad.tried == 89 + 25 + 5);  // keeps the list from silently shrinking
 }
 
 // ---------------------------------------------------------------------------------------------------------------
