@@ -85,7 +85,7 @@ double eulerian_velocity(const System& system, const Vec<2, typename System::sca
   for (std::size_t f = 0; f < p.size(); ++f) {
     if (p.kind[f] != Kind::fluid) continue;
     const T r = (p.position[f] - x).norm(), h = p.smoothing_length[f];
-    if (r >= T(std::decay_t<decltype(kernel)>::support) * h) continue;
+    if (r >= support_radius<typename System::kernel_type>(h)) continue;
     const T w = p.mass[f] / p.density[f] * kernel.value(r, h);
     sum_w += w, sum_u += w * p.velocity[f][0];
   }
