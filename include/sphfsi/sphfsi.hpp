@@ -25,6 +25,7 @@
 #include <sphfsi/eos/linear.hpp>
 #include <sphfsi/eos/tait.hpp>
 #include <sphfsi/fluid/particle_refinement.hpp>
+#include <sphfsi/fluid/thin_structure_guard.hpp>
 #include <sphfsi/fluid/thin_structure_visibility.hpp>
 #include <sphfsi/fluid/wcsph.hpp>
 #include <sphfsi/integrators/concepts.hpp>

@@ -88,6 +88,12 @@ class ThinStructureVisibility {
   /// Whether slot a has any candidate edge (a pair with neither particle near an edge is never blocked).
   bool near(std::size_t a) const noexcept { return head_[a] >= 0; }
 
+  /// Calls f(edge index) for each candidate edge of slot a (as found by the last update()).
+  template <class F>
+  void for_each_candidate(std::size_t a, F&& f) const {
+    for (std::int32_t e = head_[a]; e >= 0; e = entries_[e].next) f(entries_[e].edge);
+  }
+
   /// Whether the pair (a at xa, b at xb) is hidden by an edge: tests the candidates of both particles.
   bool blocks(std::size_t a, std::size_t b, const Vector& xa, const Vector& xb) const noexcept {
     return crosses_any(head_[a], xa, xb) || crosses_any(head_[b], xa, xb);

@@ -41,6 +41,7 @@
 #include <sphfsi/core/error.hpp>
 #include <sphfsi/core/parallel.hpp>
 #include <sphfsi/core/types.hpp>
+#include <sphfsi/fluid/thin_structure_guard.hpp>
 #include <sphfsi/fluid/thin_structure_visibility.hpp>
 #include <sphfsi/kernel/concepts.hpp>
 
@@ -93,6 +94,9 @@ struct FluidParameters {
   /// Pairs whose segment crosses an edge of a thin structure (WcsphFluid::set_structure_edges) do not interact
   /// (true); false: the published edges are ignored and the fluid interacts through the structure in its sums.
   bool thin_structure_visibility{false};
+  /// With thin_structure_visibility: a fluid particle that stepped through a structure within a step is put back on
+  /// the face it started on (fluid/thin_structure_guard.hpp; the Simulation applies it after each step).
+  bool thin_structure_guard{true};
 
   void validate() const {
     for (int d = 0; d < Dim; ++d) require_finite("FluidParameters::gravity", gravity[d]);
@@ -130,9 +134,21 @@ class WcsphFluid {
   void set_structure_edges(std::vector<StructureEdge> edges) {
     if (Dim != 2 && !edges.empty())
       throw InputError("WcsphFluid::set_structure_edges: thin-structure visibility is 2D only (valid: Dim = 2)");
+    if constexpr (Dim == 2) guard_.set_edges(edges);
     visibility_.set_edges(std::move(edges));
   }
   const ThinStructureVisibility<T>& structure_visibility() const noexcept { return visibility_; }
+
+  /// After a step (positions at its start in position_old): puts back the fluid particles that stepped through a
+  /// thin structure (FluidParameters::thin_structure_guard); returns how many. Needs this step's compute_rates.
+  std::size_t keep_fluid_beside_structures(System& system) {
+    if constexpr (Dim == 2) {
+      if (occluded_ && params_.thin_structure_guard) return guard_.restore(system.particles(), visibility_);
+    }
+    return 0;
+  }
+  /// Fluid particles put back by keep_fluid_beside_structures since construction.
+  std::size_t structure_crossings_prevented() const noexcept { return guard_.crossings_prevented(); }
 
   /// Overwrites acceleration, density_rate and xsph_velocity of fluid and wall particles
   /// (pressure and sound speed must be current: System::update_pressure(), neighbours too:
@@ -472,6 +488,7 @@ class WcsphFluid {
   std::vector<Mat<Dim, T>> correction_;    // L_a per slot (valid where corrected_[a])
   std::vector<unsigned char> corrected_;   // 1: slot a uses the corrected pressure gradient
   ThinStructureVisibility<T> visibility_;  // edges of thin structures (2D)
+  ThinStructureGuard<T> guard_;            // keeps the fluid on its face of them
   bool occluded_{false};                   // this evaluation applies the visibility criterion
 };
 

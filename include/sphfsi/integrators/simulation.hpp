@@ -124,6 +124,7 @@ class Simulation {
     if (!initialised_) initialise();
     const T dt = next_time_step();
     Integrator{}.step(*this, dt);
+    fluid_.keep_fluid_beside_structures(system_);
     time_ += dt;
     dt_ = dt;
     ++steps_;
