@@ -2,6 +2,7 @@
 // which moves it treats as crossings (geometry, one step by hand), and a jet against a held blade whose repulsion
 // is too weak to stop it: without the guard the water goes through the blade, with it none does.
 #include <sphfsi/core/particle_system.hpp>
+#include <sphfsi/coupling/blade_drag.hpp>
 #include <sphfsi/coupling/coupled_body.hpp>
 #include <sphfsi/coupling/repulsive_force.hpp>
 #include <sphfsi/eos/tait.hpp>
@@ -115,7 +116,7 @@ struct JetResult {
 
 // A 2 m/s jet of water against a held blade (0.4 mm thick, 5 mm particles) whose repulsion is 100 times weaker than
 // the default (k = 1e-4): the push cannot stop the water within the blade's range, and nothing else stands in its way.
-JetResult weak_blade_jet(bool guard) {
+JetResult weak_blade_jet(bool visibility, bool guard) {
   System system(Domain<2, double>(V(-0.05, -0.05), V(0.25, 0.3)), Tait<double>(1000, 40));
   const Resolution<double> res{0.005, 1.3};
   add_fluid_block(system, V(0, 0), V(0.06, 0.06), res, 0.0, 0.0);
@@ -133,7 +134,7 @@ JetResult weak_blade_jet(bool guard) {
   weak.strength = 1e-4;
   FluidParameters<2, double> fluid;
   fluid.gravity = V::Zero();
-  fluid.thin_structure_visibility = true;
+  fluid.thin_structure_visibility = visibility;
   fluid.thin_structure_guard = guard;
   Simulation<System, SymplecticVerlet, Body> sim(system, fluid, {}, Body(weak, std::move(rod)));
   sim.set_warning_handler([](const std::string&) {});
@@ -151,14 +152,31 @@ JetResult weak_blade_jet(bool guard) {
 }  // namespace
 
 TEST_CASE("thin-structure guard: water that a weak blade cannot stop does not go through it", "[visibility][guard]") {
-  const JetResult without = weak_blade_jet(false);
-  const JetResult with = weak_blade_jet(true);
-  INFO("without the guard: " << without.crossed << " fluid particles across the blade, x-momentum "
-                             << without.momentum_x << "; with it: " << with.crossed << " across, " << with.prevented
-                             << " put back, x-momentum " << with.momentum_x);
-  CHECK(without.crossed > 10);  // the weak repulsion alone fails: the method's failure this guard exists for
-  CHECK(without.prevented == 0);
-  CHECK(with.crossed == 0);
-  CHECK(with.prevented >= without.crossed);     // every would-be crossing was caught (some more than once)
-  CHECK(with.momentum_x < without.momentum_x);  // the blade stops the water
+  // With the visibility criterion (the faces do not see each other) and without it (one fluid across the blade).
+  for (const bool visibility : {true, false}) {
+    const JetResult without = weak_blade_jet(visibility, false);
+    const JetResult with = weak_blade_jet(visibility, true);
+    INFO("visibility " << visibility << ": without the guard " << without.crossed
+                       << " fluid particles across the blade, x-momentum " << without.momentum_x << "; with it "
+                       << with.crossed << " across, " << with.prevented << " put back, x-momentum " << with.momentum_x);
+    CHECK(without.crossed > 10);  // the weak repulsion alone fails: the failure this guard exists for
+    CHECK(without.prevented == 0);
+    CHECK(with.crossed == 0);
+    CHECK(with.prevented >= without.crossed);     // every would-be crossing was caught (some more than once)
+    CHECK(with.momentum_x < without.momentum_x);  // the blade stops the water
+  }
+}
+
+TEST_CASE("thin-structure guard: a porous (drag) blade publishes no edges", "[visibility][guard]") {
+  static_assert(permeable_coupling<BladeDrag<double>> && !permeable_coupling<RepulsiveForce<double>>);
+  System system(Domain<2, double>(V(-0.1, -0.1), V(0.2, 0.2)), Tait<double>(1000, 20));
+  add_elastic_rod(system, V(0, 0), V(0, 1), 0.1, 11, blade_material(), blade_section(), 0.0065, 1);
+  Rod::Parameters params;
+  params.section = blade_section();
+  const Rod rod(system, 1, blade_material(), params);
+  std::vector<StructureEdge> impermeable, permeable;
+  Body(RepulsiveForce<double>{}, rod).structure_edges(impermeable);
+  CoupledBody<BladeDrag<double>, Rod>(BladeDrag<double>{}, rod).structure_edges(permeable);
+  CHECK(impermeable.size() == 10);
+  CHECK(permeable.empty());
 }

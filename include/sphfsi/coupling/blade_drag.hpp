@@ -53,6 +53,8 @@ T plate_added_mass_per_area(T fluid_density, T width, T coefficient = T(1)) {
 template <Real T>
 struct BladeDrag {
   static constexpr const char* name = "blade-drag";
+  /// The water passes through the blade (coupling/concepts.hpp): no thin-structure edges.
+  static constexpr bool permeable = true;
   /// C_D on the velocity normal to the blade (1.95: a flat plate normal to a steady flow, the value of the
   /// Luhar & Nepf 2011 reconfiguration model), [0, 10].
   T drag_coefficient{T(1.95)};

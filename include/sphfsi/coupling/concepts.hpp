@@ -10,6 +10,9 @@
 // A coupling whose pair forces are stiffer than the fluid may also provide
 //   template <class System, class Solid> T stable_time_step(const System&, const Solid&) const;
 // (without the CFL factor); CoupledBody then limits the fluid step by it.
+// A coupling that lets the fluid through the solid (a porous blade exchanging its drag) says so with
+//   static constexpr bool permeable = true;
+// its solid then publishes no thin-structure edges: the fluid neither hides pairs across it nor is kept on a face.
 // CoupledBody<Coupling, Solid> (coupling/coupled_body.hpp) turns a coupling and a SolidModel into one ParticleModel.
 #pragma once
 
@@ -24,5 +27,12 @@ concept FsiCoupling = std::is_trivially_copyable_v<C> &&
   { C::name } -> std::convertible_to<const char*>;
   c.apply(s, solid, t);
 };
+
+/// Whether a coupling lets the fluid pass through its solid (C::permeable, false when absent).
+template <class C>
+inline constexpr bool permeable_coupling = [] {
+  if constexpr (requires { C::permeable; }) return bool(C::permeable);
+  else return false;
+}();
 
 }  // namespace sphfsi

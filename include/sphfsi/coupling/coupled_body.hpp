@@ -52,10 +52,13 @@ class CoupledBody {
     requires requires(Solid& s, Reader& r) { s.load_checkpoint(r); }
   void load_checkpoint(Reader& r) { solid_.load_checkpoint(r); }
 
-  /// The solid's thin-structure edges, if it has any (Simulation hides fluid pairs across them).
+  /// The solid's thin-structure edges, if it has any and the coupling is not permeable (the fluid may hide pairs
+  /// across them and is kept on its face of them: fluid/thin_structure_visibility.hpp, thin_structure_guard.hpp).
   template <class Edges>
     requires requires(const Solid& s, Edges& e) { s.structure_edges(e); }
-  void structure_edges(Edges& edges) const { solid_.structure_edges(edges); }
+  void structure_edges(Edges& edges) const {
+    if constexpr (!permeable_coupling<Coupling>) solid_.structure_edges(edges);
+  }
 
   Solid& solid() noexcept { return solid_; }
   const Solid& solid() const noexcept { return solid_; }

@@ -94,8 +94,9 @@ struct FluidParameters {
   /// Pairs whose segment crosses an edge of a thin structure (WcsphFluid::set_structure_edges) do not interact
   /// (true); false: the published edges are ignored and the fluid interacts through the structure in its sums.
   bool thin_structure_visibility{false};
-  /// With thin_structure_visibility: a fluid particle that stepped through a structure within a step is put back on
-  /// the face it started on (fluid/thin_structure_guard.hpp; the Simulation applies it after each step).
+  /// A fluid particle that stepped through a thin structure within a step is put back on the face it started on
+  /// (fluid/thin_structure_guard.hpp; the Simulation applies it after each step), with or without the visibility
+  /// criterion. Structures of permeable couplings (porous blades) publish no edges, so it does not apply to them.
   bool thin_structure_guard{true};
 
   void validate() const {
@@ -143,7 +144,7 @@ class WcsphFluid {
   /// thin structure (FluidParameters::thin_structure_guard); returns how many. Needs this step's compute_rates.
   std::size_t keep_fluid_beside_structures(System& system) {
     if constexpr (Dim == 2) {
-      if (occluded_ && params_.thin_structure_guard) return guard_.restore(system.particles(), visibility_);
+      if (guarded_) return guard_.restore(system.particles(), visibility_);
     }
     return 0;
   }
@@ -172,10 +173,11 @@ class WcsphFluid {
       volume_[a] = p.mass[a] / p.density[a];                              // m^3 (m^2 in 2D)
     });
     if (params_.gradient_correction != GradientCorrection::none) update_gradient_correction(system);
-    occluded_ = false;
+    occluded_ = guarded_ = false;
     if constexpr (Dim == 2) {
       occluded_ = params_.thin_structure_visibility && visibility_.active();
-      if (occluded_) visibility_.update(system);
+      guarded_ = params_.thin_structure_guard && visibility_.active();
+      if (occluded_ || guarded_) visibility_.update(system);  // the guard uses the same candidate edges
     }
     // A few slot ranges per thread, handed out dynamically: wall particles cost less than fluid ones, and on a
     // shared machine a thread may be descheduled for a while.
@@ -490,6 +492,7 @@ class WcsphFluid {
   ThinStructureVisibility<T> visibility_;  // edges of thin structures (2D)
   ThinStructureGuard<T> guard_;            // keeps the fluid on its face of them
   bool occluded_{false};                   // this evaluation applies the visibility criterion
+  bool guarded_{false};                    // this evaluation prepared the thin-structure guard
 };
 
 }  // namespace sphfsi
