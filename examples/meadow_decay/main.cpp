@@ -81,6 +81,7 @@ struct Options {
   // Fluid pairs across a blade interact (false: the 2D full-width blades every 3 dp would otherwise be a dam that
   // holds the whole wave pressure difference; see docs/meadow.md), and the weak repulsion that stops the fluid.
   bool visibility = false;
+  bool guard = true;  // impermeable blades: put back fluid that steps through one (fluid/thin_structure_guard.hpp)
   std::string repulsion = "stop";  // blade repulsion strength: stop | hydrostatic
   // blade coupling: drag (porous blades exchange their Morison drag with the fluid, coupling/blade_drag.hpp) |
   // repulsive (the repulsive force of eqs 17-23; the fluid leaks through it in the SPH sums, docs/meadow.md)
@@ -153,7 +154,7 @@ std::vector<T> gauge_positions(const Options& o) {
 
 struct RunResult {
   std::vector<T> height, height_std;  // per gauge
-  std::size_t fluid{0}, wall{0}, solid{0}, steps{0}, sub_steps{0}, crossings{0};
+  std::size_t fluid{0}, wall{0}, solid{0}, steps{0}, sub_steps{0}, crossings{0}, put_back{0};
   T wall_seconds{0}, reached{0}, max_stretch{1}, lowest_node{std::numeric_limits<T>::quiet_NaN()};
   T lowest_tip{std::numeric_limits<T>::quiet_NaN()};  // over all blades and samples, m above the bed
   std::vector<T> tip_dx_amplitude;                    // first, middle, last blade, m
@@ -176,6 +177,7 @@ RunResult run_case(const Options& o, const std::filesystem::path& dir) {
   const auto layout = scenes::build_wave_flume(system, g);
   auto fluid = scenes::wave_flume_fluid(g);
   fluid.thin_structure_visibility = o.visibility;
+  fluid.thin_structure_guard = o.guard;
   const auto bases = blade_positions(o);
   const waves::Wavemaker<T> maker(g.wave);
   const auto wave = maker.wave();
@@ -243,6 +245,8 @@ RunResult run_case(const Options& o, const std::filesystem::path& dir) {
   try {
     sim.run(end_time, [&](Solver& sm) {
       progress(sm);
+      // Impermeable blades every step: between samples a particle beside a tip could go round it.
+      if constexpr (Kind == Run::repulsive) crossings.update(sm.system(), sm.template model<1>());
       if (sm.time() + 1e-9 >= next_sample) {
         gauges.sample(sm.system(), sm.time());
         if constexpr (WithMeadow) {
@@ -273,7 +277,7 @@ RunResult run_case(const Options& o, const std::filesystem::path& dir) {
               }
             }
           }
-          crossings.update(sm.system(), blades);
+          if constexpr (Kind == Run::drag) crossings.update(sm.system(), blades);  // porous: the water passes
           r.max_stretch = std::max(r.max_stretch, blades.max_stretch());
           const T low = blades.lowest_free_node(T(0), o.sheath);
           r.lowest_node = std::isnan(r.lowest_node) ? low : std::min(r.lowest_node, low);
@@ -297,6 +301,7 @@ RunResult run_case(const Options& o, const std::filesystem::path& dir) {
   r.reached = sim.time();
   if constexpr (WithMeadow) r.sub_steps = sim.template model<1>().sub_step_total();
   r.crossings = crossings.total();
+  r.put_back = sim.fluid().structure_crossings_prevented();
   if (velocity_samples > 0) {
     r.relative_velocity_amplitude = std::sqrt(T(2) * relative_square / T(velocity_samples));
     r.fluid_velocity_amplitude = std::sqrt(T(2) * fluid_square / T(velocity_samples));
@@ -364,6 +369,9 @@ int main(int argc, char** argv) try {
       cli.get_switch("visibility", false,
                      "on: fluid pairs across a blade do not interact (visibility criterion; a 2D blade is "
                      "then a full-width wall) | off: they do, the blade acts on the fluid by its repulsion only");
+  o.guard = cli.get_switch("guard", true,
+                           "impermeable blades: on: a fluid particle that steps through a blade is put back on its "
+                           "face (counted) | off");
   o.repulsion = cli.get("repulsion", "stop",
                         "blade repulsion strength: stop (weakest that stops the fluid at 3 x the orbital velocity) | "
                         "hydrostatic (each face holds its side's hydrostatic load: for --visibility on)");
@@ -550,10 +558,11 @@ int main(int argc, char** argv) try {
     }
     fmt::print(
         "meadow run: {} + {} + {} particles, {} steps, {} rod sub-steps, {:.1f} s wall; max stretch {:.4f}; lowest "
-        "free node {:.4f} m, lowest tip {:.4f} m above the bed; fluid particles that crossed a blade {}; tip |dx| "
-        "of the first, middle, last blade {:.1f}, {:.1f}, {:.1f} mm{}\n",
+        "free node {:.4f} m, lowest tip {:.4f} m above the bed; fluid particles that crossed a blade {} (put back by "
+        "the guard: {}); "
+        "tip |dx| of the first, middle, last blade {:.1f}, {:.1f}, {:.1f} mm{}\n",
         with.fluid, with.wall, with.solid, with.steps, with.sub_steps, with.wall_seconds, with.max_stretch,
-        with.lowest_node, with.lowest_tip, with.crossings, 1e3 * with.tip_dx_amplitude[0],
+        with.lowest_node, with.lowest_tip, with.crossings, with.put_back, 1e3 * with.tip_dx_amplitude[0],
         1e3 * with.tip_dx_amplitude[1], 1e3 * with.tip_dx_amplitude[2],
         with.failure.empty() ? "" : "; FAILED: " + with.failure);
   }
@@ -587,7 +596,8 @@ int main(int argc, char** argv) try {
                                                 "crossings",
                                                 "lowest_node",
                                                 "max_stretch",
-                                                "lowest_tip"});
+                                                "lowest_tip",
+                                                "put_back"});
   summary.write_row({g.dp(),
                      T(bases.size()),
                      rms,
@@ -607,7 +617,8 @@ int main(int argc, char** argv) try {
                      T(with.crossings),
                      with.lowest_node,
                      with.max_stretch,
-                     with.lowest_tip});
+                     with.lowest_tip,
+                     T(with.put_back)});
   const std::string plot =
       fmt::format("/usr/bin/python3 {}/examples/meadow_decay/plot.py {} {}/luhar2017_meadow_H1_wave_decay.csv",
                   SPHFSI_SOURCE_DIR, o.out.string(), SPHFSI_SHARED_DATA_DIR);

@@ -397,7 +397,9 @@ RodBlades<System, BladeDrag<typename System::scalar_type>> add_drag_blades(
 /// Counts fluid particles that crossed a blade between two calls: a fluid particle beside a blade (its nearest
 /// point on the blade inside an edge, not at the tip, and closer than `reach`) has a side (sign of the offset along
 /// the edge normal); a particle beside the same blade at two consecutive calls on opposite sides has crossed it.
-/// Particles that pass over the tip are not beside the blade there, so they are not counted.
+/// Particles that pass over the tip are not beside the blade there, so they are not counted, provided the calls are
+/// close enough in time: call it every step (between samples far apart, a particle beside the tip can go round it and
+/// be counted).
 template <class System>
 class BladeCrossingCounter {
  public:
