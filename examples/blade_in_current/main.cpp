@@ -28,6 +28,7 @@
 #include <sphfsi/io/progress.hpp>
 #include <sphfsi/kernel/wendland_c2.hpp>
 #include <sphfsi/scenes/builders.hpp>
+#include <sphfsi/scenes/meadow.hpp>
 #include <sphfsi/solid/elastic_rod.hpp>
 
 #include <fmt/format.h>
@@ -61,6 +62,7 @@ struct Options {
   bool velocity_factor = false;  // eps(u_perp) of eq. 23: off, it rectifies the jitter of a light blade
   T normal_damping = 0;          // beta of the coupling's normal dashpot (off: see docs/thin-blades.md)
   bool visibility = true;        // fluid pairs across the blade do not interact (fluid/thin_structure_visibility.hpp)
+  bool guard = true;             // fluid that steps through the blade is put back (fluid/thin_structure_guard.hpp)
   // repulsive: the blade is resolved as an obstacle (eqs 17-23) | drag: porous, it exchanges its Morison drag with
   // the fluid (coupling/blade_drag.hpp), the drag law of Luhar & Nepf's model itself: a check of the rod and of the
   // fluid's response, not of the flow around the blade
@@ -138,6 +140,7 @@ CaseResult run_case(const Options& o, T target_ca) {
   fluid.gravity = V::Zero();
   fluid.artificial_viscosity = T(0.02);
   fluid.thin_structure_visibility = o.visibility && !porous;  // the fluid passes a porous blade
+  fluid.thin_structure_guard = o.guard;
   Coupling coupling;
   if constexpr (porous) {
     coupling.drag_coefficient = o.blade_cd;
@@ -163,8 +166,16 @@ CaseResult run_case(const Options& o, T target_ca) {
   io::ProgressReporter progress(t_end);
   const auto start = std::chrono::steady_clock::now();
   T next_sample = 0;
+  // Fluid particles that crossed the (impermeable) blade, counted every step, and those the guard put back.
+  struct OneBlade {
+    const Rod& only;
+    std::size_t size() const noexcept { return 1; }
+    const Rod& rod(std::size_t) const noexcept { return only; }
+  };
+  scenes::BladeCrossingCounter<System> crossings(T(1.5) * dp);
   sim.run(t_end, [&](Solver& s) {
     progress(s);
+    if constexpr (!porous) crossings.update(s.system(), OneBlade{s.template model<0>().solid()});
     if (s.time() < next_sample) return;
     next_sample += T(0.005);
     const auto& p = s.system().particles();
@@ -180,6 +191,9 @@ CaseResult run_case(const Options& o, T target_ca) {
   });
   progress.finish(sim);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if constexpr (!porous)
+    fmt::print("fluid particles that crossed the blade: {} (put back by the guard: {})\n", crossings.total(),
+               sim.fluid().structure_crossings_prevented());
   // Mean drag and its standard error from 8 blocks (the samples are correlated within a block).
   const std::size_t blocks = 8, per = samples.size() / blocks;
   if (per == 0) {  // a run shorter than the averaging window (--end-time): no drag average
@@ -224,6 +238,8 @@ int main(int argc, char** argv) try {
       "--coupling drag: share phi of the channel's width the blade covers (b / W; 1: a full-width row), (0, 1]");
   o.visibility = cli.get_switch("visibility", true,
                                 "on: fluid pairs across the blade do not interact (visibility criterion) | off");
+  o.guard =
+      cli.get_switch("guard", true, "on: a fluid particle that steps through the blade is put back on its face | off");
   o.global_step =
       cli.get_switch("global-step", false,
                      "on: the fluid steps with the rod's stable step (no sub-cycling; for the cost comparison) | off");

@@ -395,11 +395,11 @@ RodBlades<System, BladeDrag<typename System::scalar_type>> add_drag_blades(
 }
 
 /// Counts fluid particles that crossed a blade between two calls: a fluid particle beside a blade (its nearest
-/// point on the blade inside an edge, not at the tip, and closer than `reach`) has a side (sign of the offset along
-/// the edge normal); a particle beside the same blade at two consecutive calls on opposite sides has crossed it.
-/// Particles that pass over the tip are not beside the blade there, so they are not counted, provided the calls are
-/// close enough in time: call it every step (between samples far apart, a particle beside the tip can go round it and
-/// be counted).
+/// point on the blade not the base or the tip with the particle beyond it, and closer than `reach`) has a side (sign of
+/// the offset along the edge normal); a particle beside the same blade at two consecutive calls on opposite sides has
+/// crossed it. Particles that pass over the tip are not beside the blade there, so they are not counted, provided the
+/// calls are close enough in time: call it every step (between samples far apart, a particle beside the tip can go
+/// round it and be counted).
 template <class System>
 class BladeCrossingCounter {
  public:
@@ -426,20 +426,21 @@ class BladeCrossingCounter {
         if (y[0] < lo[0] || y[0] > hi[0] || y[1] < lo[1] || y[1] > hi[1]) continue;
         T best = std::numeric_limits<T>::infinity();
         signed char side = 0;
+        bool beyond = false;
         for (std::size_t j = 0; j + 1 < x.size(); ++j) {
           const Vector e = x[j + 1] - x[j];
           const T s = (y - x[j]).dot(e) / e.squaredNorm();
-          const bool last = j + 2 == x.size();
-          if (s < T(0) || (last && s > T(1))) continue;  // below the base or beyond the tip: not beside
-          const Vector c = x[j] + std::min(s, T(1)) * e;
+          const Vector c = x[j] + std::clamp(s, T(0), T(1)) * e;
           const T d = (y - c).norm();
           if (d < best) {
             best = d;
             const T cross = e.x() * (y - x[j]).y() - e.y() * (y - x[j]).x();
             side = cross > T(0) ? 1 : -1;
+            beyond = (j == 0 && s < T(0)) || (j + 2 == x.size() && s > T(1));
           }
         }
-        if (!(best < reach_)) continue;
+        // Nearest to the base or the tip with the particle beyond it: not beside the blade.
+        if (beyond || !(best < reach_)) continue;
         const std::uint64_t key = (std::uint64_t(b) << 32) | p.id[f];
         now[key] = side;
         const auto it = sides_.find(key);
