@@ -203,10 +203,10 @@ TEST_CASE("thin-structure guard: a step through a blade is put back, a step roun
 
   CHECK(guard.restore(p, visibility) == 1);
   CHECK(guard.crossings_prevented() == 1);
-  // Mirrored across the moved blade line x = 0.0005: 1.5 mm to its right becomes 1.5 mm to its left; the normal
-  // velocity relative to the blade (0.3 - 0.05) is removed, the tangential one kept.
+  // Back across the moved blade line x = 0.0005, at the 1 mm it was from the blade at the start of the step; the
+  // normal velocity relative to the blade (0.3 - 0.05) is removed, the tangential one kept.
   const V x = p.position[p.slot_of_id(through)], v = p.velocity[p.slot_of_id(through)];
-  CHECK(x[0] == Approx(0.0005 - 0.0015).margin(1e-12));
+  CHECK(x[0] == Approx(0.0005 - 0.001).margin(1e-12));
   CHECK(x[1] == Approx(0.0501).margin(1e-12));
   CHECK(v[0] == Approx(0.05).margin(1e-12));
   CHECK(v[1] == Approx(0.1).margin(1e-12));
@@ -215,11 +215,18 @@ TEST_CASE("thin-structure guard: a step through a blade is put back, a step roun
   CHECK(p.position[p.slot_of_id(stays)] == V(-0.0035, 0.072));
   CHECK(p.position[p.slot_of_id(far)] == V(-0.049, 0.05));
 
-  // A particle that lands exactly on the blade line is put back at min_offset x the edge length from it.
+  // A particle that lands exactly on the blade line is put back at the 4 mm it was from it; one that started closer
+  // than min_offset x the edge length (1 % of 5 mm) at that offset.
   for (std::size_t i = 0; i < p.size(); ++i) p.position_old[i] = p.position[i];
   move(stays, V(0.0005, 0.072), V(0, 0));
   CHECK(guard.restore(p, visibility) == 1);
+  CHECK(p.position[p.slot_of_id(stays)][0] == Approx(0.0005 - 0.004).margin(1e-12));
+  p.position[p.slot_of_id(stays)] = V(0.0005 - 1e-5, 0.072);
+  for (std::size_t i = 0; i < p.size(); ++i) p.position_old[i] = p.position[i];
+  move(stays, V(0.0015, 0.072), V(0, 0));
+  CHECK(guard.restore(p, visibility) == 1);
   CHECK(p.position[p.slot_of_id(stays)][0] == Approx(0.0005 - 0.01 * 0.005).margin(1e-12));
+  CHECK(guard.crossings_prevented() == 3);
 
   guard.set_edges(right_edges);  // the visibility still has both blades: a mismatch is an error, not a silent skip
   CHECK_THROWS_WITH(guard.restore(p, visibility), Catch::Contains("call set_edges"));

@@ -9,8 +9,9 @@
 // particle's nearest point on the chain at the start of the step (old positions of the particle and of the nodes) and
 // at its end. Beside the chain means that nearest point is not beyond a free end (a blade's base or tip; a particle
 // passing over the tip goes round the blade, it does not cross it). A particle beside the chain at both times, within
-// `reach` of it, on opposite faces has crossed: it is mirrored back across the line of its nearest edge (at least
-// `min_offset` x that edge's length from it), and its velocity relative to the edge (nodes' velocities interpolated)
+// `reach` of it, on opposite faces has crossed: it is moved back across the line of its nearest edge, to the
+// distance from the structure it had at the start of the step (at least `min_offset` x that edge's length), and
+// its velocity relative to the edge (nodes' velocities interpolated)
 // loses the component towards the wrong face: an inelastic collision with the edge. The impulse is given to the
 // fluid particle only (the blade does not feel it), so the guard is a last resort whose use is counted
 // (crossings_prevented()): the coupling should make it rare.
@@ -151,13 +152,15 @@ class ThinStructureGuard {
     if (before.edge < 0 || before.face == T(0) || !(before.distance < reach_)) return false;
     const Nearest after = nearest(p, visibility, f, c, p.position[f], false);
     if (after.edge < 0 || !(after.distance < reach_) || after.face == before.face) return false;
-    // Mirror back across the line of the nearest edge, to the face it started on.
+    // Back across the line of the nearest edge, to the face it started on, as far from the line as it was from the
+    // structure at the start of the step (the mirror image of a small overshoot would sit deep in the coupling's
+    // repulsion and be thrown off).
     const auto [s0, s1] = slots_[after.edge];
     const Vector a = p.position[s0], t = p.position[s1] - a;
     const T length = t.norm();
     const Vector normal = Vector(-t[1], t[0]) / length * before.face;  // towards the starting face
     const T offset = (p.position[f] - a).dot(normal);                  // <= 0: on the wrong side of the line
-    p.position[f] += (std::max(std::abs(offset), min_offset_ * length) - offset) * normal;
+    p.position[f] += (std::max(before.distance, min_offset_ * length) - offset) * normal;
     const Vector edge_velocity = (T(1) - after.along) * p.velocity[s0] + after.along * p.velocity[s1];
     const T towards_wrong_face = (p.velocity[f] - edge_velocity).dot(normal);
     if (towards_wrong_face < T(0)) p.velocity[f] -= towards_wrong_face * normal;
