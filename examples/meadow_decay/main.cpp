@@ -154,7 +154,7 @@ std::vector<T> gauge_positions(const Options& o) {
 
 struct RunResult {
   std::vector<T> height, height_std;  // per gauge
-  std::size_t fluid{0}, wall{0}, solid{0}, steps{0}, sub_steps{0}, crossings{0}, put_back{0};
+  std::size_t fluid{0}, wall{0}, solid{0}, steps{0}, sub_steps{0}, crossings{0}, put_back{0}, moved_with_blade{0};
   T wall_seconds{0}, reached{0}, max_stretch{1}, lowest_node{std::numeric_limits<T>::quiet_NaN()};
   T lowest_tip{std::numeric_limits<T>::quiet_NaN()};  // over all blades and samples, m above the bed
   std::vector<T> tip_dx_amplitude;                    // first, middle, last blade, m
@@ -302,6 +302,7 @@ RunResult run_case(const Options& o, const std::filesystem::path& dir) {
   if constexpr (WithMeadow) r.sub_steps = sim.template model<1>().sub_step_total();
   r.crossings = crossings.total();
   r.put_back = sim.fluid().structure_crossings_prevented();
+  r.moved_with_blade = sim.fluid().structure_guard().moved_with_edge();
   if (velocity_samples > 0) {
     r.relative_velocity_amplitude = std::sqrt(T(2) * relative_square / T(velocity_samples));
     r.fluid_velocity_amplitude = std::sqrt(T(2) * fluid_square / T(velocity_samples));
@@ -559,11 +560,11 @@ int main(int argc, char** argv) try {
     fmt::print(
         "meadow run: {} + {} + {} particles, {} steps, {} rod sub-steps, {:.1f} s wall; max stretch {:.4f}; lowest "
         "free node {:.4f} m, lowest tip {:.4f} m above the bed; fluid particles that crossed a blade {} (put back by "
-        "the guard: {}); "
+        "the guard: {}, of which {} moved with the blade); "
         "tip |dx| of the first, middle, last blade {:.1f}, {:.1f}, {:.1f} mm{}\n",
         with.fluid, with.wall, with.solid, with.steps, with.sub_steps, with.wall_seconds, with.max_stretch,
-        with.lowest_node, with.lowest_tip, with.crossings, with.put_back, 1e3 * with.tip_dx_amplitude[0],
-        1e3 * with.tip_dx_amplitude[1], 1e3 * with.tip_dx_amplitude[2],
+        with.lowest_node, with.lowest_tip, with.crossings, with.put_back, with.moved_with_blade,
+        1e3 * with.tip_dx_amplitude[0], 1e3 * with.tip_dx_amplitude[1], 1e3 * with.tip_dx_amplitude[2],
         with.failure.empty() ? "" : "; FAILED: " + with.failure);
   }
   if (o.run_meadow && o.coupling == "drag" && !std::isnan(with.relative_velocity_amplitude)) {

@@ -160,6 +160,31 @@ TEST_CASE("thin-structure visibility: the fluid beside a held blade does not fee
 
 // ---- the guard (fluid/thin_structure_guard.hpp) ----
 
+TEST_CASE("thin-structure guard: the swept test of a moving point against a moving edge", "[visibility][guard]") {
+  using Guard = ThinStructureGuard<double>;
+  const V o(0, 0), up(0, 1);
+  // A still point swept over by an edge moving right: met halfway, 0.3 along it, from its right (x < 0 first).
+  const auto swept = Guard::crossing(V(0.5, 0.3), V(0.5, 0.3), V(0, 0), V(1, 0), V(0, 1), V(1, 1));
+  CHECK(swept.time == Approx(0.5));
+  CHECK(swept.along == Approx(0.3));
+  CHECK(swept.side == -1);
+  CHECK(swept.offset == Approx(0.5));
+  // A point moving past the end of a still edge: its line is crossed beyond the edge, no meeting.
+  CHECK(Guard::crossing(V(-0.1, 1.2), V(0.1, 1.2), o, o, up, up).time < 0);
+  // Starting on the line is not a crossing; ending on it is (at t = 1).
+  CHECK(Guard::crossing(V(0, 0.5), V(0.1, 0.5), o, o, up, up).time < 0);
+  CHECK(Guard::crossing(V(-0.1, 0.5), V(0, 0.5), o, o, up, up).time == Approx(1));
+  // An edge turning about its base (0 to 90 degrees, its tip along a chord) sweeps a still point at 45 degrees:
+  // the tip moves (1, 0) -> (0, 1) linearly: the point (0.4, 0.4) lies on the edge when the
+  // tip is at (0.5, 0.5), t = 0.5, along = 0.4 / 0.5 = 0.8.
+  const auto turned = Guard::crossing(V(0.4, 0.4), V(0.4, 0.4), o, o, V(1, 0), V(0, 1));
+  CHECK(turned.time == Approx(0.5));
+  CHECK(turned.along == Approx(0.8));
+  CHECK(turned.side == 1);
+  // A point that goes through and back within the step ends on its own side: no crossing.
+  CHECK(Guard::crossing(V(-0.1, 0.5), V(-0.05, 0.5), o, o, up, up).time < 0);
+}
+
 TEST_CASE("thin-structure guard: a step through a blade is put back, a step round its tip or between blades is not",
           "[visibility][guard]") {
   System system(Domain<2, double>(V(-0.1, -0.1), V(0.2, 0.2)), Tait<double>(1000, 20));
@@ -183,7 +208,6 @@ TEST_CASE("thin-structure guard: a step through a blade is put back, a step roun
   visibility.set_edges(edges);
   visibility.update(system);
   ThinStructureGuard<double> guard;
-  guard.set_edges(edges);
   // One step by hand: old positions as now, then the moves.
   for (std::size_t i = 0; i < p.size(); ++i) p.position_old[i] = p.position[i];
   const auto move = [&](std::uint32_t id, V to, V velocity) {
@@ -228,10 +252,7 @@ TEST_CASE("thin-structure guard: a step through a blade is put back, a step roun
   CHECK(p.position[p.slot_of_id(stays)][0] == Approx(0.0005 - 0.01 * 0.005).margin(1e-12));
   CHECK(guard.crossings_prevented() == 3);
 
-  guard.set_edges(right_edges);  // the visibility still has both blades: a mismatch is an error, not a silent skip
-  CHECK_THROWS_WITH(guard.restore(p, visibility), Catch::Contains("call set_edges"));
-  CHECK_THROWS_WITH(guard.set_limits(0.0, 0.01), Catch::Contains("reach"));
-  CHECK_THROWS_WITH(guard.set_limits(0.01, 0.7), Catch::Contains("min_offset"));
+  CHECK_THROWS_WITH(guard.set_min_offset(0.7), Catch::Contains("min_offset"));
 }
 
 namespace {

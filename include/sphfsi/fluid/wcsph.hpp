@@ -135,7 +135,6 @@ class WcsphFluid {
   void set_structure_edges(std::vector<StructureEdge> edges) {
     if (Dim != 2 && !edges.empty())
       throw InputError("WcsphFluid::set_structure_edges: thin-structure visibility is 2D only (valid: Dim = 2)");
-    if constexpr (Dim == 2) guard_.set_edges(edges);
     visibility_.set_edges(std::move(edges));
   }
   const ThinStructureVisibility<T>& structure_visibility() const noexcept { return visibility_; }
@@ -150,6 +149,8 @@ class WcsphFluid {
   }
   /// Fluid particles put back by keep_fluid_beside_structures since construction.
   std::size_t structure_crossings_prevented() const noexcept { return guard_.crossings_prevented(); }
+  /// The guard itself (its counts).
+  const ThinStructureGuard<T>& structure_guard() const noexcept { return guard_; }
 
   /// Overwrites acceleration, density_rate and xsph_velocity of fluid and wall particles
   /// (pressure and sound speed must be current: System::update_pressure(), neighbours too:

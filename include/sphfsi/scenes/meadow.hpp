@@ -50,6 +50,7 @@
 #include <sphfsi/coupling/blade_drag.hpp>
 #include <sphfsi/coupling/coupled_body.hpp>
 #include <sphfsi/coupling/repulsive_force.hpp>
+#include <sphfsi/fluid/thin_structure_guard.hpp>
 #include <sphfsi/solid/elastic_rod.hpp>
 
 #include <fmt/format.h>
@@ -394,12 +395,10 @@ RodBlades<System, BladeDrag<typename System::scalar_type>> add_drag_blades(
   return Blades(std::move(blades), how.load_smoothing_passes);
 }
 
-/// Counts fluid particles that crossed a blade between two calls: a fluid particle beside a blade (its nearest
-/// point on the blade not the base or the tip with the particle beyond it, and closer than `reach`) has a side (sign of
-/// the offset along the edge normal); a particle beside the same blade at two consecutive calls on opposite sides has
-/// crossed it. Particles that pass over the tip are not beside the blade there, so they are not counted, provided the
-/// calls are close enough in time: call it every step (between samples far apart, a particle beside the tip can go
-/// round it and be counted).
+/// Counts fluid particles that crossed a blade between two calls: a particle within `reach` of a blade's bounding
+/// box at both calls whose path (its two positions) met one of the blade's edges (its nodes' two positions), all
+/// taken to move linearly in between (ThinStructureGuard::crossing, the guard's own swept test). Water going round
+/// the tip never meets an edge. Call it every step: between calls far apart the motion is not linear.
 template <class System>
 class BladeCrossingCounter {
  public:
@@ -408,46 +407,36 @@ class BladeCrossingCounter {
 
   explicit BladeCrossingCounter(T reach) : reach_(reach) { require_positive("BladeCrossingCounter reach (m)", reach); }
 
-  /// Updates the sides from the current state; returns the crossings found since the last call.
+  /// Updates the positions from the current state; returns the crossings found since the last call.
   template <class Blades>
   std::size_t update(const System& system, const Blades& blades) {
     const auto& p = system.particles();
-    std::unordered_map<std::uint64_t, signed char> now;
     std::size_t crossed = 0;
+    if (nodes_.size() != blades.size()) nodes_.assign(blades.size(), {}), near_.assign(blades.size(), {});
     for (std::size_t b = 0; b < blades.size(); ++b) {
       const auto& x = blades.rod(b).positions();
+      std::unordered_map<std::uint32_t, Vector> now;
       if (x.empty()) continue;
       Vector lo = x[0], hi = x[0];
       for (const auto& v : x) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
       lo.array() -= reach_, hi.array() += reach_;
+      const auto& before = nodes_[b];
       for (std::size_t f = 0; f < p.size(); ++f) {
         if (p.kind[f] != Kind::fluid) continue;
         const Vector& y = p.position[f];
         if (y[0] < lo[0] || y[0] > hi[0] || y[1] < lo[1] || y[1] > hi[1]) continue;
-        T best = std::numeric_limits<T>::infinity();
-        signed char side = 0;
-        bool beyond = false;
-        for (std::size_t j = 0; j + 1 < x.size(); ++j) {
-          const Vector e = x[j + 1] - x[j];
-          const T s = (y - x[j]).dot(e) / e.squaredNorm();
-          const Vector c = x[j] + std::clamp(s, T(0), T(1)) * e;
-          const T d = (y - c).norm();
-          if (d < best) {
-            best = d;
-            const T cross = e.x() * (y - x[j]).y() - e.y() * (y - x[j]).x();
-            side = cross > T(0) ? 1 : -1;
-            beyond = (j == 0 && s < T(0)) || (j + 2 == x.size() && s > T(1));
+        now.emplace(p.id[f], y);
+        const auto it = near_[b].find(p.id[f]);
+        if (it == near_[b].end() || before.size() != x.size()) continue;
+        for (std::size_t j = 0; j + 1 < x.size(); ++j)
+          if (ThinStructureGuard<T>::crossing(it->second, y, before[j], x[j], before[j + 1], x[j + 1]).time > T(0)) {
+            ++crossed;
+            break;
           }
-        }
-        // Nearest to the base or the tip with the particle beyond it: not beside the blade.
-        if (beyond || !(best < reach_)) continue;
-        const std::uint64_t key = (std::uint64_t(b) << 32) | p.id[f];
-        now[key] = side;
-        const auto it = sides_.find(key);
-        if (it != sides_.end() && it->second != side) ++crossed;
       }
+      nodes_[b] = x;
+      near_[b] = std::move(now);
     }
-    sides_ = std::move(now);
     total_ += crossed;
     return crossed;
   }
@@ -455,7 +444,8 @@ class BladeCrossingCounter {
 
  private:
   T reach_;
-  std::unordered_map<std::uint64_t, signed char> sides_;
+  std::vector<std::vector<Vector>> nodes_;                       // per blade: node positions at the last call
+  std::vector<std::unordered_map<std::uint32_t, Vector>> near_;  // per blade: fluid near it at the last call, by id
   std::size_t total_{0};
 };
 
