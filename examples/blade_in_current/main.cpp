@@ -63,6 +63,7 @@ struct Options {
   T normal_damping = 0;          // beta of the coupling's normal dashpot (off: see docs/thin-blades.md)
   bool visibility = true;        // fluid pairs across the blade do not interact (fluid/thin_structure_visibility.hpp)
   bool guard = true;             // fluid that steps through the blade is put back (fluid/thin_structure_guard.hpp)
+  T contact_gap = 2;             // resolved blade: height of its contact plane above the bed, in fluid spacings
   // repulsive: the blade is resolved as an obstacle (eqs 17-23) | drag: porous, it exchanges its Morison drag with
   // the fluid (coupling/blade_drag.hpp), the drag law of Luhar & Nepf's model itself: a check of the rod and of the
   // fluid's response, not of the flow around the blade
@@ -123,10 +124,12 @@ CaseResult run_case(const Options& o, T target_ca) {
   // its added mass from it.
   if constexpr (porous) params.added_mass_per_area = plate_added_mass_per_area(rho, section.width);
   Rod rod(system, 1, material, params);
-  // A blade folding over rests one fluid spacing above the bed: the fluid trapped under it keeps a row of room
-  // (at dp / 2 the first fluid row was crushed between the bed and the blade, a blow-up at Ca = 390). A porous
-  // blade traps no fluid: its contact plane is the bed itself (a gap g would hold its lowest g upright).
-  rod.set_contact_plane(V(0, 0), V(0, 1), porous ? T(0) : dp);
+  // A resolved blade folding over rests contact_gap fluid spacings above the bed, so the fluid trapped under it keeps
+  // room: at dp / 2 the first fluid row was crushed between the bed and the blade (a blow-up at Ca = 390); at dp,
+  // once the guard stops that water escaping through the blade, it is squeezed through the bed instead (Ca = 142,
+  // 0.92 s); 2 dp holds. A porous blade traps no fluid: its contact plane is the bed itself (a gap g would hold its
+  // lowest g upright).
+  rod.set_contact_plane(V(0, 0), V(0, 1), porous ? T(0) : o.contact_gap * dp);
   if (target_ca > 0) rod.clamp_base();
   else rod.clamp_where([](const V&) { return true; });  // the rigid reference blade
   // Towing: velocity U (1 - cos(pi t / ramp)) / 2 during the ramp, U after it.
@@ -240,6 +243,11 @@ int main(int argc, char** argv) try {
                                 "on: fluid pairs across the blade do not interact (visibility criterion) | off");
   o.guard =
       cli.get_switch("guard", true, "on: a fluid particle that steps through the blade is put back on its face | off");
+  o.contact_gap =
+      cli.get_number("contact-gap", 2,
+                     "resolved blade: its contact plane's height above the bed, in fluid spacings, [0.5, 10] "
+                     "(session 4-7 runs: 1)");
+  require_in_range("--contact-gap", o.contact_gap, T(0.5), T(10));
   o.global_step =
       cli.get_switch("global-step", false,
                      "on: the fluid steps with the rod's stable step (no sub-cycling; for the cost comparison) | off");
