@@ -329,3 +329,26 @@ TEST_CASE("thin-structure guard: a porous (drag) blade publishes no edges", "[vi
   CHECK(impermeable.size() == 10);
   CHECK(permeable.empty());
 }
+
+TEST_CASE("thin-structure guard: candidate lists rebuilt after the particle set changed since the evaluation",
+          "[visibility][guard]") {
+  // A refinement model may add, remove and re-sort particles after the evaluation that built the candidate lists.
+  System system(Domain<2, double>(V(-0.1, -0.1), V(0.2, 0.2)), Tait<double>(1000, 20));
+  const double h = 0.0065;
+  const auto rod = add_elastic_rod(system, V(0, 0), V(0, 1), 0.1, 21, blade_material(), blade_section(), h, 1);
+  auto& p = system.particles();
+  const std::uint32_t through = p.id[p.add(Kind::fluid, V(-0.001, 0.05), V::Zero(), 1000, 0.025, h)];
+  p.add(Kind::fluid, V(-0.004, 0.03), V::Zero(), 1000, 0.025, h);
+  WcsphFluid<System> fluid(FluidParameters<2, double>{});
+  fluid.set_structure_edges(chain_edges(rod));
+  system.update_neighbors();
+  system.update_pressure();
+  fluid.compute_rates(system);  // builds the candidate lists for this set
+  for (int k = 0; k < 30; ++k)  // new particles, then a re-sort: every slot may hold another particle now
+    p.add(Kind::fluid, V(0.05 + 0.003 * k, 0.15), V::Zero(), 1000, 0.025, h);
+  system.update_neighbors();
+  for (std::size_t i = 0; i < p.size(); ++i) p.position_old[i] = p.position[i];
+  p.position[p.slot_of_id(through)] = V(0.002, 0.05);
+  CHECK(fluid.keep_fluid_beside_structures(system) == 1);
+  CHECK(p.position[p.slot_of_id(through)][0] == Approx(-0.001).margin(1e-12));
+}

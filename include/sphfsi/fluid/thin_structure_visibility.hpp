@@ -51,6 +51,7 @@ class ThinStructureVisibility {
     const auto& p = system.particles();
     const std::size_t n = p.size();
     head_.assign(n, -1);
+    ids_.assign(p.id.begin(), p.id.end());
     entries_.clear();
     from_.resize(edges_.size());
     to_.resize(edges_.size());
@@ -83,6 +84,13 @@ class ThinStructureVisibility {
         });
       }
     }
+  }
+
+  /// Whether the candidate lists still fit the particle set: the same particles in the same slots as at update()
+  /// (a model that splits, merges or re-sorts particles after the evaluation invalidates them).
+  template <class Particles>
+  bool matches(const Particles& p) const noexcept {
+    return p.size() == ids_.size() && std::equal(ids_.begin(), ids_.end(), p.id.begin());
   }
 
   /// Whether slot a has any candidate edge (a pair with neither particle near an edge is never blocked).
@@ -124,6 +132,7 @@ class ThinStructureVisibility {
   std::vector<StructureEdge> edges_;
   std::vector<Vector> from_, to_;   // current end points of each edge
   std::vector<std::int32_t> head_;  // per slot: first candidate entry, -1: none
+  std::vector<std::uint32_t> ids_;  // particle id per slot at update()
   std::vector<Entry> entries_;      // linked lists of candidate edges
 };
 

@@ -140,10 +140,15 @@ class WcsphFluid {
   const ThinStructureVisibility<T>& structure_visibility() const noexcept { return visibility_; }
 
   /// After a step (positions at its start in position_old): puts back the fluid particles that stepped through a
-  /// thin structure (FluidParameters::thin_structure_guard); returns how many. Needs this step's compute_rates.
+  /// thin structure (FluidParameters::thin_structure_guard); returns how many. Needs this step's compute_rates and a
+  /// neighbour index that fits the particles as they are now.
   std::size_t keep_fluid_beside_structures(System& system) {
     if constexpr (Dim == 2) {
-      if (guarded_) return guard_.restore(system.particles(), visibility_);
+      if (!guarded_) return 0;
+      // A model may have split, merged or re-sorted particles since the evaluation (it then rebuilt the neighbour
+      // index): the candidate lists are rebuilt for the particles as they are now.
+      if (!visibility_.matches(system.particles())) visibility_.update(system);
+      return guard_.restore(system.particles(), visibility_);
     }
     return 0;
   }
