@@ -103,24 +103,22 @@ class ThinStructureGuard {
     parallel_for(p.size(), [&](std::size_t f) {
       if (p.kind[f] != Kind::fluid || !visibility.near(f)) return;
       // Put back across the first edge met; the corrected path may still meet another edge (a folded blade, two
-      // blades close together): test again, a few times, then let the particle ride with the edge it met.
-      bool moved = false;
-      for (int pass = 0; pass < 4; ++pass) {
-        Meeting first;
-        const std::int32_t edge = first_meeting(p, visibility, f, first);
-        if (edge < 0) break;
-        moved = true;
-        const auto [s0, s1] = slots_[edge];
-        if (pass == 3) {  // still crossing: keep its start offset from the point of the edge it met
+      // blades close together): test again, up to three put-backs, then let the particle ride with the edge it met.
+      Meeting first;
+      std::int32_t edge = first_meeting(p, visibility, f, first);
+      if (edge < 0) return;
+      put_back.fetch_add(1, std::memory_order_relaxed);
+      for (int put_backs = 0; edge >= 0; edge = first_meeting(p, visibility, f, first)) {
+        if (put_backs++ == 3) {  // still crossing: keep its start offset from the point of the edge it met
+          const auto [s0, s1] = slots_[edge];
           const Vector then = (T(1) - first.along) * p.position_old[s0] + first.along * p.position_old[s1];
           const Vector now = (T(1) - first.along) * p.position[s0] + first.along * p.position[s1];
           p.position[f] = p.position_old[f] + (now - then);
           rode.fetch_add(1, std::memory_order_relaxed);
-        } else {
-          put_back_across(p, f, edge, first);
+          break;
         }
+        put_back_across(p, f, edge, first);
       }
-      if (moved) put_back.fetch_add(1, std::memory_order_relaxed);
     });
     total_ += put_back.load();
     rode_total_ += rode.load();
