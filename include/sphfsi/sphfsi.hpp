@@ -24,6 +24,7 @@
 #include <sphfsi/eos/concepts.hpp>
 #include <sphfsi/eos/linear.hpp>
 #include <sphfsi/eos/tait.hpp>
+#include <sphfsi/fluid/adaptive_refinement.hpp>
 #include <sphfsi/fluid/particle_refinement.hpp>
 #include <sphfsi/fluid/thin_structure_guard.hpp>
 #include <sphfsi/fluid/thin_structure_visibility.hpp>

@@ -37,6 +37,10 @@ struct ParticleSet {
   std::vector<std::int32_t> body;   ///< body or wall group index (-1: none); solids use it for the body id
   std::vector<std::uint32_t> id;    ///< stable identity: creation counter, unique, < id_capacity()
   std::vector<Vector> normal;       ///< outward unit normal of wall/solid surface particles (zero elsewhere)
+  /// 1: a passive fluid particle of an overlapping resolution (fluid/adaptive_refinement.hpp): a model sets its
+  /// velocity and density from the particles of the other resolution, the fluid gives it no rates, and it serves
+  /// as a neighbour of its own resolution's active particles. 0 (the default): an ordinary particle.
+  std::vector<std::uint8_t> passive;
 
   // Derived per-particle quantities (recomputed each evaluation).
   std::vector<T> pressure;     ///< Pa
@@ -79,6 +83,7 @@ struct ParticleSet {
     body.push_back(body_index);
     id.push_back(next_id_);
     normal.push_back(Vector::Zero());
+    passive.push_back(0);
     pressure.push_back(T(0));
     sound_speed.push_back(T(0));
     acceleration.push_back(Vector::Zero());
@@ -110,6 +115,7 @@ struct ParticleSet {
       move_last_into(slot, body);
       move_last_into(slot, id);
       move_last_into(slot, normal);
+      move_last_into(slot, passive);
       move_last_into(slot, pressure);
       move_last_into(slot, sound_speed);
       move_last_into(slot, acceleration);
@@ -142,6 +148,7 @@ struct ParticleSet {
     apply(order, body);
     apply(order, id);
     apply(order, normal);
+    apply(order, passive);
     apply(order, pressure);
     apply(order, sound_speed);
     apply(order, acceleration);
@@ -212,6 +219,7 @@ struct ParticleSet {
     body.pop_back();
     id.pop_back();
     normal.pop_back();
+    passive.pop_back();
     pressure.pop_back();
     sound_speed.pop_back();
     acceleration.pop_back();

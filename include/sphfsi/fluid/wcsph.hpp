@@ -98,6 +98,12 @@ struct FluidParameters {
   /// (fluid/thin_structure_guard.hpp; the Simulation applies it after each step), with or without the visibility
   /// criterion. Structures of permeable couplings (porous blades) publish no edges, so it does not apply to them.
   bool thin_structure_guard{true};
+  /// Fluid-fluid and fluid-wall pairs interact only between particles of the same smoothing length (within 0.1 %):
+  /// each resolution of an adaptive particle refinement is a complete SPH discretisation of its own, with its own
+  /// walls, and the resolutions meet only through passive particles (fluid/adaptive_refinement.hpp; Chiron et al.
+  /// 2018). false: every pair interacts with the averaged smoothing length (splitting and merging,
+  /// fluid/particle_refinement.hpp). Fluid-solid pairs belong to the couplings either way.
+  bool same_resolution_pairs{false};
 
   void validate() const {
     for (int d = 0; d < Dim; ++d) require_finite("FluidParameters::gravity", gravity[d]);
@@ -205,7 +211,14 @@ class WcsphFluid {
     }
     const Vector g = params_.gravity;
     parallel_for(n, [&](std::size_t a) {
-      if (p.kind[a] == Kind::fluid) p.acceleration[a] += g;
+      if (p.kind[a] != Kind::fluid) return;
+      if (p.passive[a]) {  // carried with the velocity its model interpolates; it only serves as a neighbour
+        p.acceleration[a] = Vector::Zero();
+        p.density_rate[a] = T(0);
+        p.xsph_velocity[a] = Vector::Zero();
+      } else {
+        p.acceleration[a] += g;
+      }
     });
   }
 
@@ -246,6 +259,10 @@ class WcsphFluid {
   // fluid to the kernel's lattice error (1 % uniform, 7.6 % at a 2:1 jump, docs/variable-resolution.md), about
   // 0.5 at a free surface.
   static constexpr T min_interior_colour = T(0.85);
+
+  // Relative difference of smoothing lengths below which two particles count as one resolution
+  // (FluidParameters::same_resolution_pairs).
+  static constexpr T same_h_tolerance = T(1e-3);
 
   // L_a for the fluid particles selected by gradient_correction (corrected_[a] = 1), from the moment matrix
   //   M_a = sum_b V_b (x_b - x_a) (x) grad_a W_ab = -sum_b V_b (dW/dr / r) dx dx^T   (dx = x_a - x_b)
@@ -408,6 +425,8 @@ class WcsphFluid {
     const T* volume = volume_.data();
 
     const bool fluid_a = ka == Kind::fluid;
+    const bool same_resolution = params_.same_resolution_pairs;
+    const T h_a = p.smoothing_length[a];
     const Vector xa = x[a], va = v[a];
     const T rho_a = rho[a], ca = c[a], ma = mass[a], pa = pressure_term[a], vol_a = volume[a];
     Vector acc = Vector::Zero(), xsph = Vector::Zero();
@@ -417,7 +436,8 @@ class WcsphFluid {
       const Kind kb = kind[b];
       const bool fluid_b = kb == Kind::fluid;
       if (kb == Kind::solid || !(fluid_a || fluid_b)) return;  // wall-wall pairs do not interact
-      if constexpr (Dim == 2) {                                // hidden from each other by a thin structure
+      if (same_resolution && std::abs(h_a - p.smoothing_length[b]) > same_h_tolerance * h_a) return;
+      if constexpr (Dim == 2) {  // hidden from each other by a thin structure
         if (occluded_ && (visibility_.near(a) || visibility_.near(b)) && visibility_.blocks(a, b, xa, x[b])) return;
       }
       const Vector vab = va - v[b];

@@ -322,9 +322,16 @@ template <class Sim>
 std::vector<typename Sim::scalar_type> fluid_parameter_list(const Sim& sim) {
   using T = typename Sim::scalar_type;
   const auto& f = sim.fluid().parameters();
-  std::vector<T> v{f.artificial_viscosity,  f.density_diffusion,          f.xsph,
-                   f.kinematic_viscosity,   T(static_cast<int>(f.walls)), f.repulsive.boundary_spacing,
-                   f.repulsive.water_level, f.repulsive.local_depth,      T(f.repulsive.vertical_axis)};
+  std::vector<T> v{f.artificial_viscosity,
+                   f.density_diffusion,
+                   f.xsph,
+                   f.kinematic_viscosity,
+                   T(static_cast<int>(f.walls)),
+                   f.repulsive.boundary_spacing,
+                   f.repulsive.water_level,
+                   f.repulsive.local_depth,
+                   T(f.repulsive.vertical_axis),
+                   T(f.same_resolution_pairs ? 1 : 0)};
   for (int d = 0; d < Sim::Dim; ++d) v.push_back(f.gravity[d]);
   return v;
 }
@@ -361,6 +368,7 @@ void write_checkpoint(const std::filesystem::path& path, const Sim& sim) {
   w.write("particles.body", p.body);
   w.write("particles.id", p.id);
   w.write("particles.normal", p.normal);
+  w.write("particles.passive", p.passive);
   w.write("particles.pressure", p.pressure);
   w.write("particles.sound_speed", p.sound_speed);
   w.write("particles.acceleration", p.acceleration);
@@ -468,6 +476,7 @@ void read_checkpoint(const std::filesystem::path& path, Sim& sim) {
   r.read_exact("particles.body", p.body, n);
   r.read_exact("particles.id", p.id, n);
   r.read_exact("particles.normal", p.normal, n);
+  r.read_exact("particles.passive", p.passive, n);
   r.read_exact("particles.pressure", p.pressure, n);
   r.read_exact("particles.sound_speed", p.sound_speed, n);
   r.read_exact("particles.acceleration", p.acceleration, n);
@@ -476,9 +485,12 @@ void read_checkpoint(const std::filesystem::path& path, Sim& sim) {
   r.read_exact("particles.position_old", p.position_old, n);
   r.read_exact("particles.velocity_old", p.velocity_old, n);
   r.read_exact("particles.density_old", p.density_old, n);
-  for (std::size_t i = 0; i < n; ++i)
+  for (std::size_t i = 0; i < n; ++i) {
     if (static_cast<std::uint8_t>(p.kind[i]) > static_cast<std::uint8_t>(Kind::solid))
       r.fail(fmt::format("particle in slot {} has an unknown kind {}", i, static_cast<int>(p.kind[i])));
+    if (p.passive[i] > 1)
+      r.fail(fmt::format("particle in slot {} has passive = {}: valid values are 0 and 1", i, int(p.passive[i])));
+  }
   std::vector<std::uint32_t> slot_of_id;
   r.read("particles.slot_of_id", slot_of_id);
   if (slot_of_id.size() < n)

@@ -1,0 +1,369 @@
+// sphfsi: refined fluid regions by adaptive particle refinement with overlapping resolutions (APR).
+//
+// Barcarolo, Le Touze, Oger & de Vuyst 2014 (J. Comput. Phys. 273:640) and Chiron, Oger, de Leffe & Le Touze 2018
+// (J. Comput. Phys. 354:552). Each resolution is a complete SPH discretisation of its own region, with its own walls:
+// with FluidParameters::same_resolution_pairs a particle interacts only with particles of its own smoothing length,
+// so no pair ever spans a jump of h (the splitting-and-merging scheme of fluid/particle_refinement.hpp lets coarse
+// and fine particles interact directly, and fails where the jump meets a wall or a free surface:
+// docs/variable-resolution.md). The resolutions meet through passive particles:
+//
+//   A box of level L asks for the spacing dp / 2^L. A fluid particle of level k (its mass in halvings of the base
+//   mass rho0 dp^Dim, Dim halvings a level) at x, with L_in the highest level of the boxes containing x and L_near
+//   that of the boxes within transition_width of x, is
+//     active     if k == L_in                      (it is integrated: the resolution of the region it is in),
+//     passive    if k < L_in                       (a coarser particle inside a finer box: kept, for when it leaves),
+//                or L_in < k <= L_near            (a finer particle in the transition zone around its box),
+//     removed    if k > L_near                    (a finer particle that left the transition zone).
+//   Passive particles get no rates from the fluid (WcsphFluid zeroes them: they move with their velocity) and serve
+//   as neighbours of their resolution's active particles, so an active particle next to a box edge has a full kernel
+//   support of its own size. After every step their velocity and density are set by Shepard interpolation from the
+//   active fluid particles of the other levels within their pair support (h_ab = (h_a + h_b) / 2):
+//     f_a = sum_b V_b f_b W(r_ab, h_ab) / sum_b V_b W(r_ab, h_ab)        (Chiron et al. 2018, sec. 2.3)
+//   Children: an active particle of level k inside the transition zone of a finer box (k < L_near) has the 2^Dim
+//   children of the square pattern x + eps s (+-1, +-1[, +-1]) (s its spacing, eps = 1/4: the fine lattice that tiles
+//   its cell), of mass m / 2^Dim and smoothing length h / 2. A child is created, passive, where none of level k + 1
+//   lies within gap_fraction of the child spacing of its position and the position is in the transition zone (not in
+//   the box: the box's fine particles only ever come in from its transition zone). So the transition zone is always
+//   filled with children, moving with the coarse flow, and they become active as they enter the box.
+//   populate() creates the children of every particle once, at the start (those in the box active).
+//
+// Conservation: the coarse particles are never created or removed (inside a box they are passive); active mass and
+// momentum are not exchanged pair-wise between resolutions, so they are conserved only to the discretisation error
+// of the transition (the active mass changes by the particles crossing a box edge; measured in
+// docs/variable-resolution.md). The model keeps no state a restart needs (levels are masses, the passive flags are
+// particle fields).
+//
+// Walls: a box that comes within a kernel support of a wall needs wall particles at its own spacing there (the scene
+// adds them beside the coarse ones; each resolution sees only its own); populate() checks it. Solids and couplings
+// are not supported inside the boxes (a coupling would see both resolutions).
+#pragma once
+
+#include <sphfsi/core/domain.hpp>
+#include <sphfsi/core/error.hpp>
+#include <sphfsi/core/parallel.hpp>
+#include <sphfsi/core/types.hpp>
+#include <sphfsi/fluid/particle_refinement.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <functional>
+#include <limits>
+#include <utility>
+#include <vector>
+
+namespace sphfsi {
+
+/// Parameters of AdaptiveRefinement (a small trivially copyable policy).
+template <Real T>
+struct AdaptiveRefinementParameters {
+  T base_spacing{0};       ///< dp, spacing of the unrefined fluid (level 0), m
+  T transition_width{0};   ///< width of the zone around a box where its particles live on as passive ones, m
+  T split_offset{0.25};    ///< eps: child offset from the parent along each axis / parent spacing, (0, 0.5)
+  T smoothing_ratio{1.3};  ///< h / spacing of the scene (used for the transition-width check), [0.5, 3]
+  /// A child is not placed where a refined particle that stays lies within this fraction of the child spacing of
+  /// its position (the place is taken), [0.25, 1].
+  T occupied_fraction{0.75};
+
+  void validate() const {
+    require_positive("AdaptiveRefinementParameters::base_spacing (m)", base_spacing);
+    require_positive("AdaptiveRefinementParameters::transition_width (m)", transition_width);
+    require_in_open_range("AdaptiveRefinementParameters::split_offset (eps)", split_offset, T(0), T(0.5));
+    require_in_range("AdaptiveRefinementParameters::smoothing_ratio (h/dp)", smoothing_ratio, T(0.5), T(3));
+    require_in_range("AdaptiveRefinementParameters::occupied_fraction", occupied_fraction, T(0.25), T(1));
+  }
+};
+
+/// What one adaptive refinement pass did.
+struct AdaptiveRefinementCounts {
+  std::size_t created{0};         ///< refined particles created (a coarser particle's pattern entered a finer box)
+  std::size_t removed{0};         ///< refined particles removed (they left their box)
+  std::size_t activated{0};       ///< passive particles that became active
+  std::size_t deactivated{0};     ///< active particles that became passive
+  std::size_t uninterpolated{0};  ///< passive particles without an active neighbour of another level (kept as is)
+};
+
+/// Adaptive particle refinement with overlapping resolutions (see the header comment). A ParticleModel: it adds no
+/// forces and does not limit the time step; its advance() runs after each step. Use it with
+/// FluidParameters::same_resolution_pairs = true.
+template <class System>
+class AdaptiveRefinement {
+ public:
+  static constexpr int Dim = System::dimension;
+  using T = typename System::scalar_type;
+  using Vector = Vec<Dim, T>;
+  using Box = RefinementBox<Dim, T>;
+  static constexpr bool checkpoint_stateless = true;
+
+  /// Throws InputError for invalid parameters, a box outside the domain or of an invalid level, boxes of different
+  /// levels that overlap without nesting, and a transition zone narrower than the kernel support of the finest
+  /// level's particles (their active neighbours at a box edge would lack part of their support).
+  AdaptiveRefinement(const Domain<Dim, T>& domain, std::vector<Box> boxes,
+                     const AdaptiveRefinementParameters<T>& params)
+      : boxes_(std::move(boxes)), params_(params) {
+    params_.validate();
+    RefinementParameters<T> check;  // the box checks are those of the splitting scheme
+    check.base_spacing = params_.base_spacing;
+    check.smoothing_ratio = params_.smoothing_ratio;
+    ParticleRefinement<System> boxes_checked(domain, boxes_, check);
+    int finest = 0;
+    for (const Box& b : boxes_) finest = std::max(finest, b.level);
+    if (finest == 0) return;
+    const T support =
+        T(System::kernel_type::support) * params_.smoothing_ratio * params_.base_spacing / std::pow(T(2), T(finest));
+    if (params_.transition_width < support)
+      throw InputError(fmt::format(
+          "AdaptiveRefinementParameters::transition_width = {} m is too narrow: valid range is >= {} m (the kernel "
+          "support of the level-{} particles)",
+          params_.transition_width, support, finest));
+  }
+
+  const std::vector<Box>& boxes() const noexcept { return boxes_; }
+  const AdaptiveRefinementParameters<T>& parameters() const noexcept { return params_; }
+
+  /// Highest level of the boxes containing x (0 outside every box).
+  int level_inside(const Vector& x) const { return highest_level(x, T(0)); }
+  /// Highest level of the boxes within transition_width of x.
+  int level_near(const Vector& x) const { return highest_level(x, params_.transition_width); }
+  /// A fluid particle's level from its smoothing length h: round(log2(smoothing_ratio dp / h)).
+  int level_of(T smoothing_length) const {
+    return static_cast<int>(std::lround(std::log2(params_.smoothing_ratio * params_.base_spacing / smoothing_length)));
+  }
+
+  // ---- ParticleModel ----
+  void compute_rates(System&, T) {}
+  T stable_time_step(const System&) const { return std::numeric_limits<T>::infinity(); }
+  /// One pass after the step [t, t + dt]; rebuilds the neighbour index if the particle set changed.
+  void advance(System& system, T t, T dt) {
+    last_ = pass(system, -1, t + dt);
+    accumulate(last_);
+  }
+
+  /// Creates the refined particles in every box and its transition zone (recursively for nested levels), sets the passive flags and rebuilds the neighbour index. Call once on the initial particles,
+  /// before the first step. Throws InputError where an active refined particle lies within its kernel support of a
+  /// wall that has no wall particles of its own spacing there.
+  void populate(System& system) {
+    system.update_neighbors(T(0));
+    for (int level = 0; level < Box::max_level; ++level) {
+      const AdaptiveRefinementCounts c = pass(system, level, T(0));
+      accumulate(c);
+      if (c.created == 0 && level >= max_box_level()) break;
+    }
+    check_walls(system);
+  }
+
+  const AdaptiveRefinementCounts& last_counts() const noexcept { return last_; }
+  const AdaptiveRefinementCounts& total_counts() const noexcept { return total_; }
+
+  /// Mass and momentum of the active fluid particles (the fluid the equations integrate).
+  std::pair<T, Vector> active_mass_momentum(const System& system) const {
+    const auto& p = system.particles();
+    T m = T(0);
+    Vector q = Vector::Zero();
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      if (p.kind[i] != Kind::fluid || p.passive[i]) continue;
+      m += p.mass[i];
+      q += p.mass[i] * p.velocity[i];
+    }
+    return {m, q};
+  }
+
+ private:
+  enum class Status : signed char { active, passive, removed };
+
+  int max_box_level() const {
+    int level = 0;
+    for (const Box& b : boxes_) level = std::max(level, b.level);
+    return level;
+  }
+
+  int highest_level(const Vector& x, T margin) const {
+    int level = 0;
+    for (const Box& b : boxes_)
+      if (b.level > level && b.contains(x, margin)) level = b.level;
+    return level;
+  }
+
+  Status status(int k, const Vector& x) const {
+    const int inside = level_inside(x);
+    if (k == inside) return Status::active;
+    if (k < inside) return Status::passive;
+    return k <= level_near(x) ? Status::passive : Status::removed;
+  }
+
+  void accumulate(const AdaptiveRefinementCounts& c) {
+    total_.created += c.created;
+    total_.removed += c.removed;
+    total_.activated += c.activated;
+    total_.deactivated += c.deactivated;
+    total_.uninterpolated += c.uninterpolated;
+  }
+
+  // Mass of a particle of level k: rho0 (dp / 2^k)^Dim (the scene's base particles have rho0 dp^Dim).
+  T nominal_mass(int k, T rho0) const { return rho0 * std::pow(params_.base_spacing / std::pow(T(2), T(k)), T(Dim)); }
+
+  // One pass (the header comment): statuses, children in the transition zones where their place is free, the
+  // particles that left their transition zone removed, the neighbour index rebuilt, the passive particles
+  // interpolated. initial_level >= 0 (populate): the particles of that level make their children, in the boxes too.
+  AdaptiveRefinementCounts pass(System& system, int initial_level, T time) {
+    auto& p = system.particles();
+    const T rho0 = system.eos().reference_density();
+    const std::size_t n = p.size();
+    AdaptiveRefinementCounts counts;
+    const std::size_t children = std::size_t(1) << Dim;
+    // 1. Statuses; particles finer than every box within transition_width of them are removed.
+    level_.assign(n, 0);
+    leaving_.assign(n, 0);
+    removals_.clear();
+    for (std::size_t a = 0; a < n; ++a) {
+      if (p.kind[a] != Kind::fluid) continue;
+      const int k = level_of_particle(p, a);
+      level_[a] = k;
+      const int inside = level_inside(p.position[a]);
+      if (k > inside && k > level_near(p.position[a])) {
+        removals_.push_back(a);
+        leaving_[a] = 1;
+        continue;
+      }
+      const std::uint8_t passive = k != inside ? 1 : 0;
+      if (passive != p.passive[a]) {
+        ++(passive ? counts.deactivated : counts.activated);
+        if (!passive) p.mass[a] = nominal_mass(k, rho0);  // a passive mass may have been reduced (step 4)
+      }
+      p.passive[a] = passive;
+    }
+    // 2. Children of the active particles in a finer box's transition zone, where no particle of their level that
+    // stays lies within occupied_fraction of their spacing (the box fills from its transition zone only).
+    created_.clear();
+    for (std::size_t a = 0; a < n; ++a) {
+      if (p.kind[a] != Kind::fluid || leaving_[a]) continue;
+      const int k = level_[a];
+      if (initial_level >= 0 ? k != initial_level : (p.passive[a] || k >= level_near(p.position[a]))) continue;
+      const T spacing = T(0.5) * params_.base_spacing / std::pow(T(2), T(k));
+      const T gap = params_.occupied_fraction * spacing;
+      for (std::size_t c = 0; c < children; ++c) {
+        Vector x = p.position[a];
+        for (int d = 0; d < Dim; ++d)
+          x[d] += ((c >> d) & 1u) ? T(2) * params_.split_offset * spacing : -T(2) * params_.split_offset * spacing;
+        if (!system.domain().contains(x) || level_near(x) <= k) continue;
+        const bool in_box = level_inside(x) > k;
+        if (in_box && initial_level < 0) continue;
+        bool taken = false;
+        system.for_each_neighbor(a, [&](std::size_t b, const Vector&, T, T) {
+          taken = taken || (p.kind[b] == Kind::fluid && !leaving_[b] && level_[b] == k + 1 &&
+                            (p.position[b] - x).squaredNorm() < gap * gap);
+        });
+        if (!taken) created_.push_back({a, x, in_box});
+      }
+    }
+    for (const Child& c : created_) {
+      const std::size_t a = c.parent;
+      const Vector velocity = p.velocity[a];  // copies: add() may reallocate the arrays
+      const T rho = p.density[a];
+      const std::size_t d = p.add(Kind::fluid, c.position, velocity, rho, nominal_mass(level_[a] + 1, rho0),
+                                  T(0.5) * p.smoothing_length[a], p.body[a]);
+      p.pressure[d] = p.pressure[a];
+      p.sound_speed[d] = p.sound_speed[a];
+      p.passive[d] = c.in_box ? 0 : 1;
+    }
+    counts.created = created_.size();
+    // 3. Removal, highest slot first (swap-with-last keeps the lower slots valid; children were appended beyond n).
+    std::sort(removals_.begin(), removals_.end(), std::greater<>());
+    for (std::size_t slot : removals_) p.remove(slot);
+    counts.removed = removals_.size();
+    // 4. Values of the passive particles from the active ones of the other levels, on the new index.
+    if (counts.created + counts.removed > 0 || initial_level >= 0) system.update_neighbors(time);
+    interpolate_passive(system, counts);
+    return counts;
+  }
+
+  // Shepard interpolation of velocity and density for the passive particles from the active fluid particles of the
+  // other levels within their pair support (the header comment). Reads active particles only and writes passive
+  // ones only, so the slots can be processed in parallel in place.
+  void interpolate_passive(System& system, AdaptiveRefinementCounts& counts) {
+    auto& p = system.particles();
+    const auto& kernel = system.kernel();
+    const std::size_t n = p.size();
+    const T rho0 = system.eos().reference_density();
+    level_.assign(n, 0);
+    for (std::size_t a = 0; a < n; ++a)
+      if (p.kind[a] == Kind::fluid) level_[a] = level_of_particle(p, a);
+    missing_.assign(n, 0);
+    parallel_for(n, [&](std::size_t a) {
+      if (p.kind[a] != Kind::fluid || !p.passive[a]) return;
+      T weight = T(0), rho = T(0);
+      Vector v = Vector::Zero();
+      system.for_each_neighbor(a, [&](std::size_t b, const Vector&, T r, T h) {
+        if (p.kind[b] != Kind::fluid || p.passive[b] || level_[b] == level_[a]) return;
+        const T w = p.mass[b] / p.density[b] * kernel.value(r, h);
+        weight += w;
+        rho += w * p.density[b];
+        v += w * p.velocity[b];
+      });
+      if (!(weight > T(0))) {
+        missing_[a] = 1;
+        return;
+      }
+      p.velocity[a] = v / weight;
+      p.density[a] = rho / weight;
+      p.pressure[a] = system.eos().pressure(p.density[a]);
+      p.sound_speed[a] = system.eos().sound_speed(p.density[a]);
+    });
+    // Passive masses: rho_a / sum_b W_ab over the particles of its level (its SPH volume), at most the nominal
+    // mass, so passive particles that bunched up (they follow an interpolated velocity, not their own pressure)
+    // do not weigh more in their active neighbours' sums than the fluid they stand for.
+    parallel_for(n, [&](std::size_t a) {
+      if (p.kind[a] != Kind::fluid || !p.passive[a]) return;
+      const T h = p.smoothing_length[a];
+      T number_density = kernel.value(T(0), h);
+      system.for_each_neighbor(a, [&](std::size_t b, const Vector&, T r, T) {
+        if (p.kind[b] == Kind::fluid && level_[b] == level_[a]) number_density += kernel.value(r, h);
+      });
+      p.mass[a] = std::min(nominal_mass(level_[a], rho0), p.density[a] / number_density);
+    });
+    for (std::uint8_t m : missing_) counts.uninterpolated += m;
+  }
+
+  void check_walls(const System& system) const {
+    const auto& p = system.particles();
+    const T support = T(System::kernel_type::support);
+    for (std::size_t a = 0; a < p.size(); ++a) {
+      if (p.kind[a] != Kind::fluid || p.passive[a]) continue;
+      const T ha = p.smoothing_length[a];
+      T own = std::numeric_limits<T>::infinity(), other = own;
+      system.for_each_neighbor(a, [&](std::size_t b, const Vector&, T r, T) {
+        if (p.kind[b] != Kind::wall) return;
+        T& nearest = std::abs(p.smoothing_length[b] - ha) <= T(1e-3) * ha ? own : other;
+        nearest = std::min(nearest, r);
+      });
+      if (other < support * ha && own > support * ha)
+        throw InputError(fmt::format(
+            "AdaptiveRefinement: the fluid particle at x = {} m, y = {} m with h = {} m lies {} m from a wall that "
+            "has no wall particles of its spacing (valid: wall particles of every refinement level within {} m of "
+            "the fluid of that level; add them where a refinement box reaches a wall)",
+            p.position[a][0], p.position[a][1], ha, other, support * ha));
+    }
+  }
+
+  struct Child {
+    std::size_t parent;  // slot
+    Vector position;
+    bool in_box;  // an active child (populate), else a passive one in a transition zone
+  };
+
+  template <class Particles>
+  int level_of_particle(const Particles& p, std::size_t a) const {
+    return level_of(p.smoothing_length[a]);
+  }
+
+  std::vector<Box> boxes_;
+  AdaptiveRefinementParameters<T> params_;
+  AdaptiveRefinementCounts last_{}, total_{};
+  std::vector<int> level_;             // per slot of the pass: level
+  std::vector<std::uint8_t> missing_;  // per slot: passive without an active neighbour of another level
+  std::vector<std::uint8_t> leaving_;  // per slot of the pass: 1 if removed in it
+  std::vector<std::size_t> removals_;  // slots to remove
+  std::vector<Child> created_;         // children to create
+};
+
+}  // namespace sphfsi
