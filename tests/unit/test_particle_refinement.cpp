@@ -3,6 +3,7 @@
 // retired ids, and the hydrostatic tank with a refined band (two levels: dp, dp/2, dp/4).
 #include "../../examples/refined_tank/refined_tank_scene.hpp"
 
+#include <sphfsi/fluid/adaptive_refinement.hpp>
 #include <sphfsi/io/checkpoint.hpp>
 #include <sphfsi/kernel/cubic_spline.hpp>
 
@@ -374,4 +375,173 @@ TEST_CASE("checkpoint after merging: ids, id capacity and the resumed run are ex
                 a.particles().mass[i] == b.particles().mass[i] && a.particles().id[i] == b.particles().id[i];
   CHECK(identical);
   CHECK(sim_b.time() == sim_a.time());
+}
+
+// ---- Adaptive particle refinement with overlapping resolutions (fluid/adaptive_refinement.hpp) ----
+
+namespace {
+
+using AprSystem = RefSystem<2>;
+using Apr = AdaptiveRefinement<AprSystem>;
+
+// A 24 x 16 block of water at dp = 0.01 m (h = 1.3 dp, cubic spline, no walls) with a level-1 box over the cells
+// [8, 16) x [4, 12) (edges between base rows) and a transition zone of 2 dp.
+struct AprBlock {
+  static constexpr double dp = 0.01;
+  AprSystem system{Domain<2, double>(V2(-0.1, -0.1), V2(0.34, 0.26)), Tait<double>(1000, 20)};
+  std::vector<RefinementBox<2, double>> boxes{{V2(8 * dp, 4 * dp), V2(16 * dp, 12 * dp), 1}};
+  AdaptiveRefinementParameters<double> params;
+  AprBlock() {
+    params.base_spacing = dp;
+    params.transition_width = 2 * dp;
+    for (int i = 0; i < 24; ++i)
+      for (int j = 0; j < 16; ++j)
+        system.particles().add(Kind::fluid, V2((i + 0.5) * dp, (j + 0.5) * dp), V2::Zero(), 1000, 1000 * dp * dp,
+                               1.3 * dp);
+    system.update_pressure();
+  }
+};
+
+}  // namespace
+
+// populate(): the box's coarse particles are passive, their children active, the transition zone holds passive
+// children, nothing beyond it; the active mass is the block's (exact for a box on cell edges).
+TEST_CASE("adaptive refinement: populate makes the box fine and its transition zone passive", "[refinement][apr]") {
+  AprBlock block;
+  const double mass0 = fluid_totals(block.system.particles()).mass;
+  Apr apr(block.system.domain(), block.boxes, block.params);
+  apr.populate(block.system);
+  const auto& p = block.system.particles();
+  std::size_t coarse_passive = 0, fine_active = 0, fine_passive = 0;
+  double active_mass = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const int level = apr.level_of(p.smoothing_length[i]);
+    const bool in_box = block.boxes[0].contains(p.position[i]);
+    const bool near_box = block.boxes[0].contains(p.position[i], block.params.transition_width);
+    if (level == 0) {
+      CHECK(bool(p.passive[i]) == in_box);
+      coarse_passive += p.passive[i];
+    } else {
+      REQUIRE(level == 1);
+      CHECK(near_box);
+      CHECK(bool(p.passive[i]) == !in_box);
+      (p.passive[i] ? fine_passive : fine_active) += 1;
+      CHECK(p.smoothing_length[i] == Approx(0.65 * AprBlock::dp).epsilon(1e-14));
+    }
+    if (!p.passive[i]) active_mass += p.mass[i];
+  }
+  CHECK(coarse_passive == 8 * 8);
+  CHECK(fine_active == 4 * 8 * 8);
+  // The transition zone (2 dp wide) around the 8 x 8 cell box: a ring of 12 x 12 - 8 x 8 cells, all inside the block.
+  CHECK(fine_passive == 4 * (12 * 12 - 8 * 8));
+  CHECK(std::abs(active_mass - mass0) <= 1e-13 * mass0);
+  CHECK(apr.active_mass_momentum(block.system).first == Approx(active_mass).epsilon(1e-14));
+}
+
+// With same_resolution_pairs the coarse particles' rates do not see the fine particles: in a uniform state (rest,
+// rho0 everywhere, no gravity) every active coarse particle's rates equal those of the coarse block alone (the
+// passive coarse particles of the box stand in for the water there); passive particles get no rates.
+TEST_CASE("adaptive refinement: resolutions interact only through passive particles of their own size",
+          "[refinement][apr]") {
+  FluidParameters<2, double> fluid;
+  fluid.gravity = V2::Zero();
+  fluid.same_resolution_pairs = true;
+  AprBlock coarse, refined;
+  // A pressure field that is not uniform, so the rates are not zero: rho = rho0 (1 + 1e-3 sin(30 x) cos(20 y)).
+  for (AprBlock* b : {&coarse, &refined}) {
+    auto& p = b->system.particles();
+    for (std::size_t i = 0; i < p.size(); ++i)
+      p.density[i] = 1000 * (1 + 1e-3 * std::sin(30 * p.position[i][0]) * std::cos(20 * p.position[i][1]));
+  }
+  Apr apr(refined.system.domain(), refined.boxes, refined.params);
+  refined.system.update_neighbors(0);
+  // populate() interpolates the passive coarse particles' density from the fine ones; keep the coarse values.
+  std::vector<double> density_by_id(refined.system.particles().size());
+  for (std::size_t i = 0; i < refined.system.particles().size(); ++i)
+    density_by_id[refined.system.particles().id[i]] = refined.system.particles().density[i];
+  apr.populate(refined.system);
+  auto& rp = refined.system.particles();
+  for (std::size_t i = 0; i < rp.size(); ++i)
+    if (rp.id[i] < density_by_id.size()) rp.density[i] = density_by_id[rp.id[i]];
+  for (AprBlock* b : {&coarse, &refined}) {
+    b->system.update_neighbors(0);
+    b->system.update_pressure();
+    WcsphFluid<AprSystem> model(fluid);
+    model.compute_rates(b->system);
+  }
+  const auto& cp = coarse.system.particles();
+  double scale = 0, worst = 0;
+  std::size_t compared = 0;
+  for (std::size_t i = 0; i < rp.size(); ++i) {
+    if (rp.passive[i]) {
+      CHECK(rp.acceleration[i].norm() == 0);
+      CHECK(rp.density_rate[i] == 0);
+      continue;
+    }
+    if (rp.id[i] >= cp.size()) continue;  // a fine particle
+    const std::size_t j = cp.slot_of_id(rp.id[i]);
+    scale = std::max(scale, cp.acceleration[j].norm());
+    worst = std::max(worst, (rp.acceleration[i] - cp.acceleration[j]).norm());
+    ++compared;
+  }
+  INFO("largest coarse acceleration " << scale << " m/s^2, largest difference " << worst);
+  CHECK(compared == 24 * 16 - 64);
+  CHECK(scale > 0);
+  CHECK(worst <= 1e-12 * scale);
+}
+
+// Shepard interpolation of the passive particles: a linear velocity field v = (0.1 + 2 x, -3 y) on the active
+// particles. Passive coarse particles deeper in the box than the pair support 2 h_ab = 1.95 dp, surrounded by fine
+// ones on the symmetric pattern, get it to round-off. Nearer the box edge (coarse) and in the transition zone (fine)
+// the stencil is one-sided: only the other level's active particles count, which stop at the edge. There the error
+// is |grad v| times the offset of the stencil's weighted centroid, bounded by the pair support 1.95 dp.
+TEST_CASE("adaptive refinement: passive particles interpolate a linear field", "[refinement][apr]") {
+  AprBlock block;
+  Apr apr(block.system.domain(), block.boxes, block.params);
+  apr.populate(block.system);
+  auto& p = block.system.particles();
+  const auto field = [](const V2& x) { return V2(0.1 + 2 * x[0], -3 * x[1]); };
+  for (std::size_t i = 0; i < p.size(); ++i) p.velocity[i] = p.passive[i] ? V2::Zero() : field(p.position[i]);
+  apr.advance(block.system, 0, 0);  // one pass with the particles where they are
+  const double support = 1.95 * AprBlock::dp;
+  double interior_error = 0, edge_error = 0;
+  std::size_t interior = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (!p.passive[i]) continue;
+    const double e = (p.velocity[i] - field(p.position[i])).norm();
+    const bool deep = apr.level_of(p.smoothing_length[i]) == 0 && block.boxes[0].contains(p.position[i], -support);
+    interior += deep;
+    (deep ? interior_error : edge_error) = std::max(deep ? interior_error : edge_error, e);
+  }
+  const double gradient = std::sqrt(2.0 * 2.0 + 3.0 * 3.0);  // Frobenius norm of grad v, 1/s
+  INFO("largest error: deep in the box " << interior_error << " m/s, at its edge " << edge_error << " m/s");
+  CHECK(apr.last_counts().created == 0);
+  CHECK(apr.last_counts().uninterpolated == 0);
+  CHECK(interior == 4 * 4);  // coarse centres 2.5 ... 5.5 dp into the 8 dp box
+  CHECK(interior_error <= 1e-12);
+  CHECK(edge_error > interior_error);
+  CHECK(edge_error <= gradient * support);
+}
+
+TEST_CASE("adaptive refinement: bad input gives an InputError naming the parameter and its valid range",
+          "[refinement][apr]") {
+  AprBlock block;
+  auto params = block.params;
+  params.transition_width = 0.5 * AprBlock::dp;  // below the level-1 support 2 x 0.65 dp
+  CHECK_THROWS_WITH(Apr(block.system.domain(), block.boxes, params),
+                    Catch::Contains("transition_width") && Catch::Contains("valid range"));
+  params = block.params;
+  params.bunched_fraction = 0.8;
+  CHECK_THROWS_WITH(Apr(block.system.domain(), block.boxes, params), Catch::Contains("bunched_fraction"));
+  auto boxes = block.boxes;
+  boxes[0].upper = V2(1.0, 0.1);  // outside the domain
+  CHECK_THROWS_WITH(Apr(block.system.domain(), boxes, block.params), Catch::Contains("outside the domain"));
+  // A box reaching a wall that has no fine wall particles.
+  AprBlock walled;
+  for (int i = -2; i < 26; ++i)
+    walled.system.particles().add(Kind::wall, V2((i + 0.5) * AprBlock::dp, -0.5 * AprBlock::dp), V2::Zero(), 1000,
+                                  1000 * AprBlock::dp * AprBlock::dp, 1.3 * AprBlock::dp);
+  std::vector<RefinementBox<2, double>> low{{V2(8 * AprBlock::dp, 0), V2(16 * AprBlock::dp, 8 * AprBlock::dp), 1}};
+  Apr touching(walled.system.domain(), low, walled.params);
+  CHECK_THROWS_WITH(touching.populate(walled.system), Catch::Contains("wall particles of its spacing"));
 }

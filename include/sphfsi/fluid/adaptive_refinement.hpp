@@ -1,41 +1,46 @@
 // sphfsi: refined fluid regions by adaptive particle refinement with overlapping resolutions (APR).
 //
-// Barcarolo, Le Touze, Oger & de Vuyst 2014 (J. Comput. Phys. 273:640) and Chiron, Oger, de Leffe & Le Touze 2018
-// (J. Comput. Phys. 354:552). Each resolution is a complete SPH discretisation of its own region, with its own walls:
-// with FluidParameters::same_resolution_pairs a particle interacts only with particles of its own smoothing length,
-// so no pair ever spans a jump of h (the splitting-and-merging scheme of fluid/particle_refinement.hpp lets coarse
-// and fine particles interact directly, and fails where the jump meets a wall or a free surface:
-// docs/variable-resolution.md). The resolutions meet through passive particles:
+// After Barcarolo, Le Touze, Oger & de Vuyst 2014 (J. Comput. Phys. 273:640) and Chiron, Oger, de Leffe & Le Touze
+// 2018 (J. Comput. Phys. 354:552). Each resolution is a complete SPH discretisation of its own region, with its own
+// walls: with FluidParameters::same_resolution_pairs a particle interacts only with particles of its own smoothing
+// length, so no pair spans a jump of h. (The splitting-and-merging scheme of fluid/particle_refinement.hpp lets
+// coarse and fine particles interact directly, and fails where the jump meets a wall or a free surface:
+// docs/variable-resolution.md.) The resolutions meet through passive particles:
 //
-//   A box of level L asks for the spacing dp / 2^L. A fluid particle of level k (its mass in halvings of the base
-//   mass rho0 dp^Dim, Dim halvings a level) at x, with L_in the highest level of the boxes containing x and L_near
-//   that of the boxes within transition_width of x, is
-//     active     if k == L_in                      (it is integrated: the resolution of the region it is in),
-//     passive    if k < L_in                       (a coarser particle inside a finer box: kept, for when it leaves),
-//                or L_in < k <= L_near            (a finer particle in the transition zone around its box),
-//     removed    if k > L_near                    (a finer particle that left the transition zone).
+//   A box of level L asks for the spacing dp / 2^L. A fluid particle of level k (from its smoothing length,
+//   h = (h/dp) dp / 2^k) at x, with L_in the highest level of the boxes containing x and L_near that of the boxes
+//   within transition_width of x, is
+//     active     if k == L_in                    (integrated: the resolution of the region it is in),
+//     passive    if k < L_in                     (a coarser particle inside a finer box, kept for when it leaves),
+//                or L_in < k <= L_near           (a finer particle in the transition zone around its box),
+//     removed    if k > L_near                   (a finer particle that left the transition zone).
 //   Passive particles get no rates from the fluid (WcsphFluid zeroes them: they move with their velocity) and serve
-//   as neighbours of their resolution's active particles, so an active particle next to a box edge has a full kernel
+//   as neighbours of their resolution's active particles, so an active particle at a box edge has a full kernel
 //   support of its own size. After every step their velocity and density are set by Shepard interpolation from the
-//   active fluid particles of the other levels within their pair support (h_ab = (h_a + h_b) / 2):
-//     f_a = sum_b V_b f_b W(r_ab, h_ab) / sum_b V_b W(r_ab, h_ab)        (Chiron et al. 2018, sec. 2.3)
-//   Children: an active particle of level k inside the transition zone of a finer box (k < L_near) has the 2^Dim
+//   active fluid particles of the other levels within their pair support (h_ab = (h_a + h_b) / 2),
+//     f_a = sum_b V_b f_b W(r_ab, h_ab) / sum_b V_b W(r_ab, h_ab),
+//   and their mass is their SPH volume times their density, m_a = rho_a / sum_b W(r_ab, h_a) over the particles of
+//   their level, at most the nominal mass rho0 (dp / 2^k)^Dim: passive particles follow an interpolated velocity,
+//   not their own pressure, and may bunch up; so bunched, they do not weigh more in their active neighbours' sums
+//   than the fluid they stand for. A particle that becomes active keeps that mass.
+//   Children: an active particle of level k in the transition zone of a finer box (k < L_near) has the 2^Dim
 //   children of the square pattern x + eps s (+-1, +-1[, +-1]) (s its spacing, eps = 1/4: the fine lattice that tiles
-//   its cell), of mass m / 2^Dim and smoothing length h / 2. A child is created, passive, where none of level k + 1
-//   lies within gap_fraction of the child spacing of its position and the position is in the transition zone (not in
-//   the box: the box's fine particles only ever come in from its transition zone). So the transition zone is always
-//   filled with children, moving with the coarse flow, and they become active as they enter the box.
-//   populate() creates the children of every particle once, at the start (those in the box active).
+//   its cell), of mass rho0 (s / 2)^Dim and smoothing length h / 2. A child is created, passive, where its position
+//   lies in the transition zone (not in the box: a box fills from its transition zone only) and no particle of level
+//   k + 1 lies within occupied_fraction of the child spacing. The transition zone therefore stays filled with
+//   children moving with the coarse flow, which become active as they enter the box.
+//   populate() creates the children of every particle in and around the boxes once, at the start (those in the box
+//   active, their parents passive).
 //
-// Conservation: the coarse particles are never created or removed (inside a box they are passive); active mass and
-// momentum are not exchanged pair-wise between resolutions, so they are conserved only to the discretisation error
-// of the transition (the active mass changes by the particles crossing a box edge; measured in
-// docs/variable-resolution.md). The model keeps no state a restart needs (levels are masses, the passive flags are
-// particle fields).
+// Conservation: the coarse particles are never created or removed (inside a box they are passive). Mass and
+// momentum are not exchanged pair-wise between resolutions, so the active mass and momentum are conserved only to
+// the discretisation error of the transition: the active mass changes as particles cross a box edge (measured in
+// docs/variable-resolution.md). The model keeps no state a restart needs (levels are smoothing lengths, passive flags
+// and masses are particle fields). One global time step, set by the finest particles.
 //
 // Walls: a box that comes within a kernel support of a wall needs wall particles at its own spacing there (the scene
 // adds them beside the coarse ones; each resolution sees only its own); populate() checks it. Solids and couplings
-// are not supported inside the boxes (a coupling would see both resolutions).
+// are not supported inside the boxes or their transition zones (a coupling would see both resolutions).
 #pragma once
 
 #include <sphfsi/core/domain.hpp>
@@ -64,6 +69,9 @@ struct AdaptiveRefinementParameters {
   /// A child is not placed where a refined particle that stays lies within this fraction of the child spacing of
   /// its position (the place is taken), [0.25, 1].
   T occupied_fraction{0.75};
+  /// A passive particle of a transition zone closer than this fraction of its spacing to another of its level is
+  /// removed (bunched up), [0.1, occupied_fraction).
+  T bunched_fraction{0.5};
 
   void validate() const {
     require_positive("AdaptiveRefinementParameters::base_spacing (m)", base_spacing);
@@ -71,6 +79,11 @@ struct AdaptiveRefinementParameters {
     require_in_open_range("AdaptiveRefinementParameters::split_offset (eps)", split_offset, T(0), T(0.5));
     require_in_range("AdaptiveRefinementParameters::smoothing_ratio (h/dp)", smoothing_ratio, T(0.5), T(3));
     require_in_range("AdaptiveRefinementParameters::occupied_fraction", occupied_fraction, T(0.25), T(1));
+    if (!(bunched_fraction >= T(0.1) && bunched_fraction < occupied_fraction))
+      throw InputError(
+          fmt::format("AdaptiveRefinementParameters::bunched_fraction = {} is invalid: valid range is [0.1, {}) (below "
+                      "occupied_fraction, or children would be removed as soon as they are made)",
+                      bunched_fraction, occupied_fraction));
   }
 };
 
@@ -139,10 +152,12 @@ class AdaptiveRefinement {
     accumulate(last_);
   }
 
-  /// Creates the refined particles in every box and its transition zone (recursively for nested levels), sets the passive flags and rebuilds the neighbour index. Call once on the initial particles,
-  /// before the first step. Throws InputError where an active refined particle lies within its kernel support of a
-  /// wall that has no wall particles of its own spacing there.
+  /// Creates the refined particles in every box and its transition zone (recursively for nested levels), sets the
+  /// passive flags and rebuilds the neighbour index. Call once on the initial particles, before the first step. Throws
+  /// InputError where an active refined particle lies within its kernel support of a wall that has no wall particles of
+  /// its own spacing there.
   void populate(System& system) {
+    lattice_number_density_ = lattice_number_density(system.kernel());
     system.update_neighbors(T(0));
     for (int level = 0; level < Box::max_level; ++level) {
       const AdaptiveRefinementCounts c = pass(system, level, T(0));
@@ -170,6 +185,28 @@ class AdaptiveRefinement {
 
  private:
   enum class Status : signed char { active, passive, removed };
+
+  // sum_b W(|x_a - x_b|, h) s^Dim over a square lattice of spacing s with h = smoothing_ratio s (1 to the kernel's
+  // lattice error): the number density of a full, ordered support in units of 1 / s^Dim.
+  template <class Kernel>
+  T lattice_number_density(const Kernel& kernel) const {
+    const T h = params_.smoothing_ratio;  // s = 1
+    const int reach = static_cast<int>(std::ceil(T(Kernel::support) * h));
+    T sum = T(0);
+    int index[3] = {-reach, -reach, -reach};
+    const int count = static_cast<int>(std::pow(2 * reach + 1, Dim));
+    for (int c = 0; c < count; ++c) {
+      int rest = c;
+      T r2 = T(0);
+      for (int d = 0; d < Dim; ++d) {
+        index[d] = rest % (2 * reach + 1) - reach;
+        rest /= 2 * reach + 1;
+        r2 += T(index[d] * index[d]);
+      }
+      sum += kernel.value(std::sqrt(r2), h);
+    }
+    return sum;
+  }
 
   int max_box_level() const {
     int level = 0;
@@ -228,9 +265,23 @@ class AdaptiveRefinement {
       const std::uint8_t passive = k != inside ? 1 : 0;
       if (passive != p.passive[a]) {
         ++(passive ? counts.deactivated : counts.activated);
-        if (!passive) p.mass[a] = nominal_mass(k, rho0);  // a passive mass may have been reduced (step 4)
       }
       p.passive[a] = passive;
+    }
+    // Passive particles of a transition zone that bunched up (closer than bunched_fraction of their spacing to a
+    // particle of their level that stays: an active one, or a passive one in a lower slot) are removed too.
+    for (std::size_t a = 0; a < n; ++a) {
+      if (p.kind[a] != Kind::fluid || leaving_[a] || !p.passive[a] || level_[a] <= level_inside(p.position[a]))
+        continue;
+      const T close = params_.bunched_fraction * params_.base_spacing / std::pow(T(2), T(level_[a]));
+      bool bunched = false;
+      system.for_each_neighbor(a, [&](std::size_t b, const Vector&, T r, T) {
+        bunched = bunched || (r < close && p.kind[b] == Kind::fluid && !leaving_[b] && level_[b] == level_[a] &&
+                              (!p.passive[b] || b < a));
+      });
+      if (!bunched) continue;
+      removals_.push_back(a);
+      leaving_[a] = 1;
     }
     // 2. Children of the active particles in a finer box's transition zone, where no particle of their level that
     // stays lies within occupied_fraction of their spacing (the box fills from its transition zone only).
@@ -319,7 +370,9 @@ class AdaptiveRefinement {
       system.for_each_neighbor(a, [&](std::size_t b, const Vector&, T r, T) {
         if (p.kind[b] == Kind::fluid && level_[b] == level_[a]) number_density += kernel.value(r, h);
       });
-      p.mass[a] = std::min(nominal_mass(level_[a], rho0), p.density[a] / number_density);
+      const T spacing = params_.base_spacing / std::pow(T(2), T(level_[a]));
+      p.mass[a] = nominal_mass(level_[a], rho0) *
+                  std::min(T(1), lattice_number_density_ / (number_density * std::pow(spacing, T(Dim))));
     });
     for (std::uint8_t m : missing_) counts.uninterpolated += m;
   }
@@ -362,6 +415,7 @@ class AdaptiveRefinement {
   std::vector<int> level_;             // per slot of the pass: level
   std::vector<std::uint8_t> missing_;  // per slot: passive without an active neighbour of another level
   std::vector<std::uint8_t> leaving_;  // per slot of the pass: 1 if removed in it
+  T lattice_number_density_{1};        // lattice_number_density() of the kernel (populate)
   std::vector<std::size_t> removals_;  // slots to remove
   std::vector<Child> created_;         // children to create
 };
