@@ -235,6 +235,9 @@ int main(int argc, char** argv) try {
                sim.step_count(), wall, made, adaptive ? "children created" : "splits", unmade,
                adaptive ? "removed" : "merges", adaptive ? "active " : "", (fluid_mass() - mass0) / mass0,
                system.particles().count(Kind::fluid));
+    if constexpr (adaptive)
+      fmt::print("mass account: largest correction of the edge particles' masses {:.2e} (one pass)\n",
+                 refinement.total_counts().mass_correction);
 
     {
       io::CsvWriter particles_csv(out / "particles.csv", {"x", "z", "level", "pressure", "speed", "passive"},

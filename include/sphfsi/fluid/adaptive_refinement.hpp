@@ -33,10 +33,14 @@
 //   active, their parents passive).
 //
 // Conservation: the coarse particles are never created or removed (inside a box they are passive). Mass and
-// momentum are not exchanged pair-wise between resolutions, so the active mass and momentum are conserved only to
-// the discretisation error of the transition: the active mass changes as particles cross a box edge (measured in
-// docs/variable-resolution.md). The model keeps no state a restart needs (levels are smoothing lengths, passive flags
-// and masses are particle fields). One global time step, set by the finest particles.
+// momentum are not exchanged pair-wise between resolutions: a particle that becomes active brings the mass it had as
+// a passive one, one that becomes passive or is removed takes its mass away. The mass account (conserve_mass) hands
+// the active mass a pass changed back to the active particles within transition_width of a box edge, each scaled by
+// 1 + dM / M_edge, so the active fluid mass is conserved to round-off over every pass; the largest |dM / M_edge| is
+// reported (AdaptiveRefinementCounts::mass_correction). Momentum is not corrected: it changes by the momentum the
+// status changes carry (measured in docs/variable-resolution.md). The model keeps no state a restart needs (levels
+// are smoothing lengths, passive flags and masses are particle fields). One global time step, set by the finest
+// particles.
 //
 // Walls: a box that comes within a kernel support of a wall needs wall particles at its own spacing there (the scene
 // adds them beside the coarse ones; each resolution sees only its own); populate() checks it. Solids and couplings
@@ -72,6 +76,9 @@ struct AdaptiveRefinementParameters {
   /// A passive particle of a transition zone closer than this fraction of its spacing to another of its level is
   /// removed (bunched up), [0.1, occupied_fraction).
   T bunched_fraction{0.5};
+  /// Whether each pass hands the active mass it changed back to the active particles near the box edges (the mass
+  /// account of the header comment), so that the active mass is conserved to round-off.
+  bool conserve_mass{true};
 
   void validate() const {
     require_positive("AdaptiveRefinementParameters::base_spacing (m)", base_spacing);
@@ -94,6 +101,9 @@ struct AdaptiveRefinementCounts {
   std::size_t activated{0};       ///< passive particles that became active
   std::size_t deactivated{0};     ///< active particles that became passive
   std::size_t uninterpolated{0};  ///< passive particles without an active neighbour of another level (kept as is)
+  /// Largest relative mass change of the mass account: the active mass the statuses changed over the active mass of
+  /// the particles near the box edges that took it back (0 without conserve_mass).
+  double mass_correction{0};
 };
 
 /// Adaptive particle refinement with overlapping resolutions (see the header comment). A ParticleModel: it adds no
@@ -234,6 +244,28 @@ class AdaptiveRefinement {
     total_.activated += c.activated;
     total_.deactivated += c.deactivated;
     total_.uninterpolated += c.uninterpolated;
+    total_.mass_correction = std::max(total_.mass_correction, c.mass_correction);
+  }
+
+  T active_mass(const System& system) const { return active_mass_momentum(system).first; }
+
+  // Whether x lies within transition_width of a box edge (on either side): the band where statuses change.
+  bool near_box_edge(const Vector& x) const {
+    return highest_level(x, params_.transition_width) != highest_level(x, -params_.transition_width);
+  }
+
+  // The mass account: the active mass a pass changed (particles that became passive or active, with the masses
+  // they carried) is handed back to the active particles near the box edges in proportion to their masses.
+  void balance_mass(System& system, T changed, AdaptiveRefinementCounts& counts) const {
+    auto& p = system.particles();
+    T band = T(0);
+    for (std::size_t a = 0; a < p.size(); ++a)
+      if (p.kind[a] == Kind::fluid && !p.passive[a] && near_box_edge(p.position[a])) band += p.mass[a];
+    if (!(band > T(0)) || changed == T(0)) return;
+    const T factor = T(1) + changed / band;
+    for (std::size_t a = 0; a < p.size(); ++a)
+      if (p.kind[a] == Kind::fluid && !p.passive[a] && near_box_edge(p.position[a])) p.mass[a] *= factor;
+    counts.mass_correction = std::abs(static_cast<double>(changed / band));
   }
 
   // Mass of a particle of level k: rho0 (dp / 2^k)^Dim (the scene's base particles have rho0 dp^Dim).
@@ -248,6 +280,7 @@ class AdaptiveRefinement {
     const std::size_t n = p.size();
     AdaptiveRefinementCounts counts;
     const std::size_t children = std::size_t(1) << Dim;
+    const T mass_before = active_mass(system);
     // 1. Statuses; particles finer than every box within transition_width of them are removed.
     level_.assign(n, 0);
     leaving_.assign(n, 0);
@@ -325,6 +358,7 @@ class AdaptiveRefinement {
     // 4. Values of the passive particles from the active ones of the other levels, on the new index.
     if (counts.created + counts.removed > 0 || initial_level >= 0) system.update_neighbors(time);
     interpolate_passive(system, counts);
+    if (initial_level < 0 && params_.conserve_mass) balance_mass(system, mass_before - active_mass(system), counts);
     return counts;
   }
 
