@@ -96,6 +96,8 @@ int main(int argc, char** argv) try {
               "resolutions, fluid/adaptive_refinement.hpp)");
   const double transition_dp =
       cli.get_number("transition", 2, "apr: transition zone width, base spacings (>= the fine kernel support)");
+  const double bunched = cli.get_number(
+      "bunched", 0.5, "apr: a passive fine particle closer than this fraction of its spacing to another is removed");
   if (!cli.finish()) return 0;
   if (method != "split" && method != "apr")
     throw InputError(fmt::format("--method = '{}' is invalid: valid values are split, apr", method));
@@ -144,6 +146,7 @@ int main(int argc, char** argv) try {
   apr_params.base_spacing = dp;
   apr_params.transition_width = transition_dp * dp;
   apr_params.smoothing_ratio = g.smoothing_ratio;
+  apr_params.bunched_fraction = bunched;
 
   // The same flume run with either refinement model.
   auto run = [&](auto model) -> int {
