@@ -256,15 +256,19 @@ class AdaptiveRefinement {
 
   // The mass account: the active mass a pass changed (particles that became passive or active, with the masses
   // they carried) is handed back to the active particles near the box edges in proportion to their masses.
-  void balance_mass(System& system, T changed, AdaptiveRefinementCounts& counts) const {
+  void balance_mass(System& system, T changed, AdaptiveRefinementCounts& counts) {
+    if (changed == T(0)) return;
     auto& p = system.particles();
+    edge_.clear();
     T band = T(0);
-    for (std::size_t a = 0; a < p.size(); ++a)
-      if (p.kind[a] == Kind::fluid && !p.passive[a] && near_box_edge(p.position[a])) band += p.mass[a];
-    if (!(band > T(0)) || changed == T(0)) return;
+    for (std::size_t a = 0; a < p.size(); ++a) {
+      if (p.kind[a] != Kind::fluid || p.passive[a] || !near_box_edge(p.position[a])) continue;
+      edge_.push_back(a);
+      band += p.mass[a];
+    }
+    if (!(band > T(0))) return;
     const T factor = T(1) + changed / band;
-    for (std::size_t a = 0; a < p.size(); ++a)
-      if (p.kind[a] == Kind::fluid && !p.passive[a] && near_box_edge(p.position[a])) p.mass[a] *= factor;
+    for (std::size_t a : edge_) p.mass[a] *= factor;
     counts.mass_correction = std::abs(static_cast<double>(changed / band));
   }
 
@@ -280,7 +284,8 @@ class AdaptiveRefinement {
     const std::size_t n = p.size();
     AdaptiveRefinementCounts counts;
     const std::size_t children = std::size_t(1) << Dim;
-    const T mass_before = active_mass(system);
+    const bool account = initial_level < 0 && params_.conserve_mass;
+    const T mass_before = account ? active_mass(system) : T(0);
     // 1. Statuses; particles finer than every box within transition_width of them are removed.
     level_.assign(n, 0);
     leaving_.assign(n, 0);
@@ -358,7 +363,7 @@ class AdaptiveRefinement {
     // 4. Values of the passive particles from the active ones of the other levels, on the new index.
     if (counts.created + counts.removed > 0 || initial_level >= 0) system.update_neighbors(time);
     interpolate_passive(system, counts);
-    if (initial_level < 0 && params_.conserve_mass) balance_mass(system, mass_before - active_mass(system), counts);
+    if (account) balance_mass(system, mass_before - active_mass(system), counts);
     return counts;
   }
 
@@ -452,6 +457,7 @@ class AdaptiveRefinement {
   T lattice_number_density_{1};        // lattice_number_density() of the kernel (populate)
   std::vector<std::size_t> removals_;  // slots to remove
   std::vector<Child> created_;         // children to create
+  std::vector<std::size_t> edge_;      // slots of the active particles near a box edge (the mass account)
 };
 
 }  // namespace sphfsi
