@@ -63,7 +63,7 @@ int main(int argc, char** argv) try {
                       "refined_wave: a regular wave crossing a refined zone (level 1 over half a wavelength, full "
                       "depth); run --refine off first, then --refine on --compare <that output>.");
   scenes::WaveFlumeGeometry<T> g;
-  g.wave.wave_height = 0.028;
+  g.wave.wave_height = cli.get_number("wave-height", 0.028, "target wave height, m (1e-9: practically still water)");
   g.wave.period = 1.4286;
   g.wave.depth = 0.16;
   g.wave.order = 2;
@@ -98,6 +98,12 @@ int main(int argc, char** argv) try {
       cli.get_number("transition", 2, "apr: transition zone width, base spacings (>= the fine kernel support)");
   const double bunched = cli.get_number(
       "bunched", 0.5, "apr: a passive fine particle closer than this fraction of its spacing to another is removed");
+  const bool own_level = cli.get_switch(
+      "own-level", false, "apr: passive particles interpolated from active ones of their own level too: on | off");
+  const bool linear = cli.get_switch("linear", false, "apr: passive values by a linear MLS fit: on | off");
+  const bool account = cli.get_switch("account", true, "apr: the mass account: on | off");
+  const bool volume_mass =
+      cli.get_switch("volume-mass", true, "apr: passive masses from their SPH volume (else nominal): on | off");
   if (!cli.finish()) return 0;
   if (method != "split" && method != "apr")
     throw InputError(fmt::format("--method = '{}' is invalid: valid values are split, apr", method));
@@ -147,6 +153,10 @@ int main(int argc, char** argv) try {
   apr_params.transition_width = transition_dp * dp;
   apr_params.smoothing_ratio = g.smoothing_ratio;
   apr_params.bunched_fraction = bunched;
+  apr_params.interpolate_from_own_level = own_level;
+  apr_params.linear_interpolation = linear;
+  apr_params.conserve_mass = account;
+  apr_params.passive_mass_from_volume = volume_mass;
 
   // The same flume run with either refinement model.
   auto run = [&](auto model) -> int {
@@ -190,12 +200,13 @@ int main(int argc, char** argv) try {
     waves::WaveGauges<T> gauges(gauge_x, layout.still_level, dp);
     gauges.open(out / "gauges.csv",
                 fmt::format("refined_wave (refine {}): eta (m) at x (m) = column suffix", refine ? "on" : "off"));
-    io::CsvWriter counts_csv(out / "counts.csv", {"t", "fluid", "level0", "level1", "mass_change", "splits", "merges"},
-                             adaptive
-                                 ? "fluid particles per level (active and passive), relative change of the active "
-                                   "mass; apr: 'splits' = children created, 'merges' = particles removed"
-                                 : "fluid particles per level (intermediate masses with the coarser), relative mass "
-                                   "change");
+    io::CsvWriter counts_csv(
+        out / "counts.csv", {"t", "fluid", "level0", "level1", "mass_change", "splits", "merges", "kinetic_energy"},
+        adaptive ? "fluid particles per level (active and passive), relative change of the active "
+                   "mass; apr: 'splits' = children created, 'merges' = particles removed; kinetic "
+                   "energy of the integrated fluid, J/m"
+                 : "fluid particles per level (intermediate masses with the coarser), relative mass "
+                   "change, kinetic energy of the fluid, J/m");
     auto fluid_mass = [&] {
       double m = 0;
       const auto& p = system.particles();
@@ -213,8 +224,11 @@ int main(int argc, char** argv) try {
         ++level[std::min(level_of(i), 1)];
       }
       const auto [made, unmade] = created_removed();
+      double kinetic = 0;
+      for (std::size_t i = 0; i < p.size(); ++i)
+        if (integrated(i)) kinetic += 0.5 * p.mass[i] * p.velocity[i].squaredNorm();
       counts_csv.write_row(
-          {t, double(n), double(level[0]), double(level[1]), (fluid_mass() - mass0) / mass0, made, unmade});
+          {t, double(n), double(level[0]), double(level[1]), (fluid_mass() - mass0) / mass0, made, unmade, kinetic});
     };
     const double sample_every = period / 80;
     double next_sample = 0, next_count = 0;
@@ -228,7 +242,7 @@ int main(int argc, char** argv) try {
       }
       if (s.time() >= next_count) {
         write_counts(s.time());
-        next_count += 0.25;
+        next_count += 0.05;
       }
     });
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

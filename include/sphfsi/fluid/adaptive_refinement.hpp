@@ -53,6 +53,9 @@
 #include <sphfsi/core/types.hpp>
 #include <sphfsi/fluid/particle_refinement.hpp>
 
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -79,6 +82,17 @@ struct AdaptiveRefinementParameters {
   /// Whether each pass hands the active mass it changed back to the active particles near the box edges (the mass
   /// account of the header comment), so that the active mass is conserved to round-off.
   bool conserve_mass{true};
+  /// Whether a passive particle is interpolated from the active particles of its own level too (h_ab = h_a), not
+  /// only from those of the other levels: near a box edge the other level is active on one side only, its own on the
+  /// other, so the stencil is two-sided.
+  bool interpolate_from_own_level{false};
+  /// Whether passive values come from a first-order (linear) moving-least-squares fit instead of the Shepard mean:
+  /// exact for linear fields, also where the stencil is one-sided (a free surface, a box edge); Shepard where the
+  /// fit's moment matrix is degenerate.
+  bool linear_interpolation{false};
+  /// Whether a passive particle's mass is its SPH volume times its density (capped at the nominal mass), else the
+  /// nominal mass rho0 s^Dim.
+  bool passive_mass_from_volume{true};
 
   void validate() const {
     require_positive("AdaptiveRefinementParameters::base_spacing (m)", base_spacing);
@@ -345,6 +359,7 @@ class AdaptiveRefinement {
         if (!taken) created_.push_back({a, x, in_box});
       }
     }
+    const auto first_child_id = p.id_capacity();
     for (const Child& c : created_) {
       const std::size_t a = c.parent;
       const Vector velocity = p.velocity[a];  // copies: add() may reallocate the arrays
@@ -362,9 +377,68 @@ class AdaptiveRefinement {
     counts.removed = removals_.size();
     // 4. Values of the passive particles from the active ones of the other levels, on the new index.
     if (counts.created + counts.removed > 0 || initial_level >= 0) system.update_neighbors(time);
+    if (initial_level >= 0 && params_.linear_interpolation) {
+      // populate: the children's density and velocity fitted from their parents' level (not copied from the parent,
+      // which would give the children of one parent one density where the field has a gradient).
+      // (Slots moved in the removal: the children are told by their ids, the parents by their smoothing lengths.)
+      parallel_for(p.size(), [&](std::size_t a) {
+        if (p.kind[a] != Kind::fluid || p.id[a] < first_child_id) return;
+        fit(system, a, [&](std::size_t b) {
+          return p.kind[b] == Kind::fluid && p.id[b] < first_child_id && level_of_particle(p, b) == initial_level;
+        });
+      });
+    }
     interpolate_passive(system, counts);
     if (account) balance_mass(system, mass_before - active_mass(system), counts);
     return counts;
+  }
+
+  // Sets velocity and density of particle a from the neighbours b with accept(b): the Shepard mean, or with
+  // linear_interpolation the linear moving-least-squares fit where its moment matrix is far from singular. Reads the
+  // accepted neighbours only and writes a only. False where no neighbour is accepted.
+  template <class Accept>
+  bool fit(System& system, std::size_t a, Accept&& accept) {
+    using Moment = Eigen::Matrix<T, Dim + 1, Dim + 1>;
+    using Column = Eigen::Matrix<T, Dim + 1, 1>;
+    using Values = Eigen::Matrix<T, Dim + 1, Dim + 1>;  // columns: density, velocity components
+    auto& p = system.particles();
+    const auto& kernel = system.kernel();
+    T weight = T(0), rho = T(0);
+    Vector v = Vector::Zero();
+    Moment moment = Moment::Zero();
+    Values rhs = Values::Zero();
+    const T scale = T(1) / p.smoothing_length[a];
+    system.for_each_neighbor(a, [&](std::size_t b, const Vector& dx, T r, T h) {
+      if (!accept(b)) return;
+      const T w = p.mass[b] / p.density[b] * kernel.value(r, h);
+      weight += w;
+      rho += w * p.density[b];
+      v += w * p.velocity[b];
+      if (params_.linear_interpolation) {
+        Column q;
+        q[0] = T(1);
+        q.template tail<Dim>() = -dx * scale;  // (x_b - x_a) / h_a
+        moment.noalias() += w * q * q.transpose();
+        Column f;
+        f[0] = p.density[b];
+        f.template tail<Dim>() = p.velocity[b];
+        rhs.noalias() += w * q * f.transpose();
+      }
+    });
+    if (!(weight > T(0))) return false;
+    p.velocity[a] = v / weight;
+    p.density[a] = rho / weight;
+    if (params_.linear_interpolation) {
+      const Moment normalised = moment / weight;
+      if (normalised.determinant() > T(1e-4)) {
+        const Values c = normalised.ldlt().solve(rhs / weight);
+        p.density[a] = c(0, 0);
+        p.velocity[a] = c.row(0).template tail<Dim>().transpose();
+      }
+    }
+    p.pressure[a] = system.eos().pressure(p.density[a]);
+    p.sound_speed[a] = system.eos().sound_speed(p.density[a]);
+    return true;
   }
 
   // Shepard interpolation of velocity and density for the passive particles from the active fluid particles of the
@@ -381,27 +455,24 @@ class AdaptiveRefinement {
     missing_.assign(n, 0);
     parallel_for(n, [&](std::size_t a) {
       if (p.kind[a] != Kind::fluid || !p.passive[a]) return;
-      T weight = T(0), rho = T(0);
-      Vector v = Vector::Zero();
-      system.for_each_neighbor(a, [&](std::size_t b, const Vector&, T r, T h) {
-        if (p.kind[b] != Kind::fluid || p.passive[b] || level_[b] == level_[a]) return;
-        const T w = p.mass[b] / p.density[b] * kernel.value(r, h);
-        weight += w;
-        rho += w * p.density[b];
-        v += w * p.velocity[b];
+      const bool found = fit(system, a, [&](std::size_t b) {
+        return p.kind[b] == Kind::fluid && !p.passive[b] &&
+               (level_[b] != level_[a] || params_.interpolate_from_own_level);
       });
-      if (!(weight > T(0))) {
+      if (!found) {
         missing_[a] = 1;
         return;
       }
-      p.velocity[a] = v / weight;
-      p.density[a] = rho / weight;
-      p.pressure[a] = system.eos().pressure(p.density[a]);
-      p.sound_speed[a] = system.eos().sound_speed(p.density[a]);
     });
     // Passive masses: rho_a / sum_b W_ab over the particles of its level (its SPH volume), at most the nominal
     // mass, so passive particles that bunched up (they follow an interpolated velocity, not their own pressure)
     // do not weigh more in their active neighbours' sums than the fluid they stand for.
+    if (!params_.passive_mass_from_volume) {
+      for (std::size_t a = 0; a < n; ++a)
+        if (p.kind[a] == Kind::fluid && p.passive[a]) p.mass[a] = nominal_mass(level_[a], rho0);
+      for (std::uint8_t m : missing_) counts.uninterpolated += m;
+      return;
+    }
     parallel_for(n, [&](std::size_t a) {
       if (p.kind[a] != Kind::fluid || !p.passive[a]) return;
       const T h = p.smoothing_length[a];
