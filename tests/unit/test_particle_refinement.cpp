@@ -497,6 +497,8 @@ TEST_CASE("adaptive refinement: resolutions interact only through passive partic
 // is |grad v| times the offset of the stencil's weighted centroid, bounded by the pair support 1.95 dp.
 TEST_CASE("adaptive refinement: passive particles interpolate a linear field", "[refinement][apr]") {
   AprBlock block;
+  block.params.linear_interpolation = false;  // the Shepard mean from the other level only
+  block.params.interpolate_from_own_level = false;
   Apr apr(block.system.domain(), block.boxes, block.params);
   apr.populate(block.system);
   auto& p = block.system.particles();
@@ -558,6 +560,97 @@ TEST_CASE("adaptive refinement: the linear fit from every level reproduces a lin
   CHECK(passive == 64 + 4 * (12 * 12 - 8 * 8));
   CHECK(velocity_error <= 1e-12);
   CHECK(density_error <= 1e-10);  // 1e-13 of rho0
+}
+
+// The still tank of the splitting test above (0.5 m deep, H / dp = 20, dynamic walls, consistent masses, alpha = 0.1
+// as there: with 0.01 the uniform tank at dp/2 is itself unstable, its kinetic energy growing 300 times over
+// 0.2-0.4 s, measured) with two nested APR boxes inside the water (level 1: dp/2 over 12 x 8 base cells; level 2:
+// dp/4 over 6 x 2 cells around mid-depth; transition 2 dp), settled for 0.5 s:
+//   pressure: within 2 % of hydrostatic at mid-depth (in the finest box) and in bands through every level;
+//   stillness: mean kinetic energy of the active fluid over the last 0.2 s below that of acoustic noise whose
+//              pressure amplitude is the pressure check's 2 % of the mid-depth pressure: u = 0.02 (rho g H / 2) /
+//              (rho c0), KE = M u^2 / 2 (M the fluid mass; 2.2 mm/s here); the uniform tank meets it too;
+//   mass: the active mass that of the tank to round-off (the mass account), no fluid particle outside the tank.
+TEST_CASE("adaptive refinement: a still tank with nested boxes (dp, dp/2, dp/4) settles to hydrostatic pressure",
+          "[refinement][apr][tank]") {
+  using TankApr = AdaptiveRefinement<tank::System>;
+  using TankAprSimulation = Simulation<tank::System, SymplecticVerlet, TankApr>;
+  tank::TankConfig cfg;
+  cfg.particles_over_depth = 20;
+  cfg.width = 0.5;
+  const double dp = cfg.dp(), zc = 0.5 * cfg.depth, end_time = 0.5;
+  const std::vector<RefinementBox<2, double>> boxes{{V2(4 * dp, zc - 4 * dp), V2(16 * dp, zc + 4 * dp), 1},
+                                                    {V2(7 * dp, zc - dp), V2(13 * dp, zc + dp), 2}};
+  AdaptiveRefinementParameters<double> params;
+  params.base_spacing = dp;
+  params.transition_width = 2 * dp;
+  params.smoothing_ratio = cfg.smoothing_ratio;
+  auto fluid = tank::fluid_parameters(cfg);
+  fluid.same_resolution_pairs = true;
+  fluid.artificial_viscosity = 0.1;
+  auto active_energy = [](const tank::System& system) {
+    const auto& p = system.particles();
+    double e = 0;
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (p.kind[i] == Kind::fluid && !p.passive[i]) e += 0.5 * p.mass[i] * p.velocity[i].squaredNorm();
+    return e;
+  };
+  auto run = [&](bool refined, tank::System& system) {
+    TankAprSimulation sim(system, fluid, {},
+                          TankApr(system.domain(), refined ? boxes : std::vector<RefinementBox<2, double>>{}, params));
+    auto& apr = sim.model<0>();
+    const double mass0 = apr.active_mass_momentum(system).first;
+    if (refined) apr.populate(system);
+    CHECK(std::abs(apr.active_mass_momentum(system).first - mass0) <= 1e-13 * mass0);
+    std::size_t lost = 0, samples = 0;
+    double energy = 0;
+    sim.run(end_time, [&](TankAprSimulation& s) {
+      lost = std::max(lost, tank::particles_outside(system, cfg));
+      if (s.time() < end_time - 0.2) return;
+      energy += active_energy(system);
+      ++samples;
+    });
+    CHECK(lost == 0);
+    CHECK(std::abs(apr.active_mass_momentum(system).first - mass0) <=
+          1e3 * std::numeric_limits<double>::epsilon() * mass0);
+    return std::pair{energy / double(samples), apr.total_counts()};
+  };
+  tank::System uniform = tank::make_tank(cfg);
+  const double uniform_energy = run(false, uniform).first;
+  tank::System system = tank::make_tank(cfg);
+  const auto [energy, counts] = run(true, system);
+  TankApr probe(system.domain(), boxes, params);
+  std::size_t per_level[3] = {0, 0, 0};
+  const auto& p = system.particles();
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (p.kind[i] == Kind::fluid) ++per_level[std::min(probe.level_of(p.smoothing_length[i]), 2)];
+  // The settled surface from the active fluid's SPH volume (tank::free_surface_height would count the box twice).
+  double volume = 0;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (p.kind[i] == Kind::fluid && !p.passive[i]) volume += p.mass[i] / p.density[i];
+  const double surface = volume / cfg.width;
+  const double p_mid = tank::shepard_pressure(system, V2(0.5 * cfg.width, zc));
+  const double p_theory = tank::hydrostatic_pressure(cfg, surface, zc);
+  INFO("mid-depth: p_sph = " << p_mid << " Pa, p_theory = " << p_theory << " Pa; surface " << surface << " m (uniform "
+                             << tank::free_surface_height(uniform, cfg) << " m); kinetic energy " << energy
+                             << " J/m (uniform " << uniform_energy << " J/m); particles per level " << per_level[0]
+                             << " / " << per_level[1] << " / " << per_level[2] << "; created " << counts.created
+                             << ", removed " << counts.removed);
+  CHECK(per_level[0] == 20 * 20);
+  CHECK(std::abs(p_mid - p_theory) / p_theory <= 0.02);
+  for (const double z : {0.2 * cfg.depth, zc - 3 * dp, zc - 0.5 * dp, zc + 3 * dp, 0.8 * cfg.depth}) {
+    const auto band = tank::band_average_pressure(system, cfg, z, 0.5 * dp);
+    const double theory = tank::hydrostatic_pressure(cfg, surface, band.elevation);
+    INFO("band at z = " << band.elevation << " m: " << band.pressure << " Pa, theory " << theory << " Pa");
+    CHECK(band.particles > 0);
+    CHECK(std::abs(band.pressure - theory) / theory <= 0.02);
+  }
+  const double fluid_mass = cfg.rho0 * cfg.depth * cfg.width;
+  const double noise_speed = 0.02 * (0.5 * cfg.gravity * cfg.depth) / cfg.sound_speed();
+  const double energy_bound = 0.5 * fluid_mass * noise_speed * noise_speed;
+  INFO("kinetic energy bound " << energy_bound << " J/m (rms speed " << noise_speed << " m/s)");
+  CHECK(uniform_energy <= energy_bound);
+  CHECK(energy <= energy_bound);
 }
 
 TEST_CASE("adaptive refinement: bad input gives an InputError naming the parameter and its valid range",

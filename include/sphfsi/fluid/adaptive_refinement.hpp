@@ -16,16 +16,20 @@
 //     removed    if k > L_near                   (a finer particle that left the transition zone).
 //   Passive particles get no rates from the fluid (WcsphFluid zeroes them: they move with their velocity) and serve
 //   as neighbours of their resolution's active particles, so an active particle at a box edge has a full kernel
-//   support of its own size. After every step their velocity and density are set by Shepard interpolation from the
-//   active fluid particles of the other levels within their pair support (h_ab = (h_a + h_b) / 2),
-//     f_a = sum_b V_b f_b W(r_ab, h_ab) / sum_b V_b W(r_ab, h_ab),
+//   support of its own size. After every step their velocity and density are set from the active fluid particles of
+//   every level within their pair support (h_ab = (h_a + h_b) / 2; their own level's too, so that the stencil is
+//   two-sided at a box edge, where the other level is active on one side only) by the linear moving-least-squares
+//   fit, weights V_b W(r_ab, h_ab): f_a = c_0 of the least-squares fit f_b ~ c_0 + c . (x_b - x_a), exact for linear
+//   fields even where the stencil is one-sided (a free surface). Where the fit's moment matrix is degenerate, and
+//   with linear_interpolation = false, the Shepard mean f_a = sum_b V_b f_b W_ab / sum_b V_b W_ab
+//   (interpolate_from_own_level = false: from the other levels only, the scheme of Chiron et al.; measured worse).
 //   and their mass is their SPH volume times their density, m_a = rho_a / sum_b W(r_ab, h_a) over the particles of
 //   their level, at most the nominal mass rho0 (dp / 2^k)^Dim: passive particles follow an interpolated velocity,
 //   not their own pressure, and may bunch up; so bunched, they do not weigh more in their active neighbours' sums
 //   than the fluid they stand for. A particle that becomes active keeps that mass.
 //   Children: an active particle of level k in the transition zone of a finer box (k < L_near) has the 2^Dim
 //   children of the square pattern x + eps s (+-1, +-1[, +-1]) (s its spacing, eps = 1/4: the fine lattice that tiles
-//   its cell), of mass rho0 (s / 2)^Dim and smoothing length h / 2. A child is created, passive, where its position
+//   its cell), each of mass m_a / 2^Dim and smoothing length h / 2. A child is created, passive, where its position
 //   lies in the transition zone (not in the box: a box fills from its transition zone only) and no particle of level
 //   k + 1 lies within occupied_fraction of the child spacing. The transition zone therefore stays filled with
 //   children moving with the coarse flow, which become active as they enter the box.
@@ -85,11 +89,11 @@ struct AdaptiveRefinementParameters {
   /// Whether a passive particle is interpolated from the active particles of its own level too (h_ab = h_a), not
   /// only from those of the other levels: near a box edge the other level is active on one side only, its own on the
   /// other, so the stencil is two-sided.
-  bool interpolate_from_own_level{false};
+  bool interpolate_from_own_level{true};
   /// Whether passive values come from a first-order (linear) moving-least-squares fit instead of the Shepard mean:
   /// exact for linear fields, also where the stencil is one-sided (a free surface, a box edge); Shepard where the
   /// fit's moment matrix is degenerate.
-  bool linear_interpolation{false};
+  bool linear_interpolation{true};
   /// Whether a passive particle's mass is its SPH volume times its density (capped at the nominal mass), else the
   /// nominal mass rho0 s^Dim.
   bool passive_mass_from_volume{true};
@@ -364,7 +368,7 @@ class AdaptiveRefinement {
       const std::size_t a = c.parent;
       const Vector velocity = p.velocity[a];  // copies: add() may reallocate the arrays
       const T rho = p.density[a];
-      const std::size_t d = p.add(Kind::fluid, c.position, velocity, rho, nominal_mass(level_[a] + 1, rho0),
+      const std::size_t d = p.add(Kind::fluid, c.position, velocity, rho, p.mass[a] / T(children),
                                   T(0.5) * p.smoothing_length[a], p.body[a]);
       p.pressure[d] = p.pressure[a];
       p.sound_speed[d] = p.sound_speed[a];
