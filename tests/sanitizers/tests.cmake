@@ -44,12 +44,14 @@ unset(_sphfsi_sanitize)
 # The refined still tank (test_particle_refinement.cpp, 11 s release) is left out too; its splitting, merging, particle
 # removal and checkpoint paths run here in the other refinement cases. So is the Posidonia blade in the still flume
 # (test_posidonia_flume.cpp, 8 s of simulated flume, 30 CPU s at -O2); its rod, dashpot and crossing-counter code runs
-# here in the coupling and rod-blade cases.
+# here in the coupling and rod-blade cases. The APR still tank with nested boxes (30 s release) is left out as well;
+# the APR passes, fits and mass account run here in the other [apr] cases.
 set(SPHFSI_SANITIZER_EXCLUDED_CASES "~TLSPH: energy of the undamped oscillating plate*"
                                     "~ULSPH: energy of the undamped oscillating plate*"
                                     "~TLSPH: oscillating plate period*"
                                     "~Solid models conserve momentum in a free*" "~ULSPH: oscillating plate period*"
-                                    "~hydrostatic tank with a refined band*" "~a real Posidonia blade stands*")
+                                    "~hydrostatic tank with a refined band*" "~a real Posidonia blade stands*"
+                                    "~adaptive refinement: a still tank*")
 add_test(NAME sanitizer.unit_tests COMMAND sphfsi_unit_tests_sanitized ${SPHFSI_SANITIZER_EXCLUDED_CASES})
 set_tests_properties(sanitizer.unit_tests PROPERTIES
   LABELS sanitizer
