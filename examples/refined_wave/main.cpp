@@ -106,6 +106,7 @@ int main(int argc, char** argv) try {
       "own-level", true, "apr: passive particles interpolated from active ones of their own level too: on | off");
   const bool linear = cli.get_switch("linear", true, "apr: passive values by a linear MLS fit: on | off");
   const bool account = cli.get_switch("account", true, "apr: the mass account: on | off");
+  const bool momentum_account = cli.get_switch("momentum-account", true, "apr: the momentum account: on | off");
   const bool volume_mass =
       cli.get_switch("volume-mass", true, "apr: passive masses from their SPH volume (else nominal): on | off");
   if (!cli.finish()) return 0;
@@ -160,6 +161,7 @@ int main(int argc, char** argv) try {
   apr_params.interpolate_from_own_level = own_level;
   apr_params.linear_interpolation = linear;
   apr_params.conserve_mass = account;
+  apr_params.conserve_momentum = momentum_account;
   apr_params.passive_mass_from_volume = volume_mass;
 
   // The same flume run with either refinement model.
@@ -257,8 +259,10 @@ int main(int argc, char** argv) try {
                adaptive ? "removed" : "merges", adaptive ? "active " : "", (fluid_mass() - mass0) / mass0,
                system.particles().count(Kind::fluid));
     if constexpr (adaptive)
-      fmt::print("mass account: largest correction of the edge particles' masses {:.2e} (one pass)\n",
-                 refinement.total_counts().mass_correction);
+      fmt::print(
+          "mass account: largest correction of the edge particles' masses {:.2e} (one pass); momentum account: largest "
+          "velocity shift {:.2e} m/s\n",
+          refinement.total_counts().mass_correction, refinement.total_counts().momentum_correction);
 
     {
       io::CsvWriter particles_csv(out / "particles.csv", {"x", "z", "level", "pressure", "speed", "passive"},

@@ -676,6 +676,50 @@ TEST_CASE("adaptive refinement: bad input gives an InputError naming the paramet
   CHECK_THROWS_WITH(touching.populate(walled.system), Catch::Contains("wall particles of its spacing"));
 }
 
+// The momentum account: the disordered block of the test below drifts through the box in a shear flow
+// v = (0.5 + 2 (y - 0.08), 0) m/s, so the mass the status changes and the mass account move carries different
+// momenta. With no forces every particle keeps its velocity (the linear fit reproduces the shear on the passive ones),
+// and the active momentum must stay P0: to round-off with conserve_momentum, and off by more than 1e-8 of |P0|
+// without it (the account is not idle).
+TEST_CASE("adaptive refinement: the momentum account conserves the active momentum to round-off", "[refinement][apr]") {
+  for (const bool conserve : {true, false}) {
+    AprBlock block;
+    block.params.conserve_momentum = conserve;
+    auto& p = block.system.particles();
+    const auto shear = [](const V2& x) { return V2(0.5 + 2 * (x[1] - 0.08), 0); };
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      p.position[i] += 0.15 * AprBlock::dp * V2(std::sin(12.9898 * double(i)), std::cos(78.233 * double(i)));
+      p.velocity[i] = shear(p.position[i]);
+    }
+    Apr apr(block.system.domain(), block.boxes, block.params);
+    apr.populate(block.system);
+    const auto [mass0, momentum0] = apr.active_mass_momentum(block.system);
+    const double dt = 0.4 * AprBlock::dp;  // 0.2 dp per pass at 0.5 m/s
+    double worst_mass = 0, worst_momentum = 0;
+    std::size_t changes = 0;
+    for (int step = 0; step < 20; ++step) {
+      for (std::size_t i = 0; i < p.size(); ++i) p.position[i] += dt * p.velocity[i];
+      block.system.update_neighbors((step + 1) * dt);
+      apr.advance(block.system, step * dt, dt);
+      const auto [mass, momentum] = apr.active_mass_momentum(block.system);
+      worst_mass = std::max(worst_mass, std::abs(mass - mass0) / mass0);
+      worst_momentum = std::max(worst_momentum, (momentum - momentum0).norm() / momentum0.norm());
+      changes += apr.last_counts().activated + apr.last_counts().deactivated + apr.last_counts().removed;
+    }
+    INFO("conserve_momentum " << conserve << ": largest |dP| / |P0| " << worst_momentum << ", largest velocity shift "
+                              << apr.total_counts().momentum_correction << " m/s, status changes " << changes);
+    CHECK(changes > 0);
+    CHECK(worst_mass <= 1e-12);
+    if (conserve) {
+      CHECK(worst_momentum <= 1e-12);
+      CHECK(apr.total_counts().momentum_correction > 0);
+    } else {
+      CHECK(worst_momentum > 1e-8);
+      CHECK(apr.total_counts().momentum_correction == 0);
+    }
+  }
+}
+
 // The mass account: a disordered block drifts at u = 0.5 m/s through the box (4 dp in 20 passes: particles cross both
 // x-edges and change status). With conserve_mass the active fluid mass stays that of the block to round-off after
 // every pass; without it the status changes move mass (the account is not idle), and the momentum of the uniform
@@ -684,6 +728,7 @@ TEST_CASE("adaptive refinement: the mass account conserves the active mass to ro
   for (const bool conserve : {true, false}) {
     AprBlock block;
     block.params.conserve_mass = conserve;
+    block.params.conserve_momentum = false;  // the mass account alone (momentum M u holds with the mass kept)
     auto& p = block.system.particles();
     const V2 u(0.5, 0);
     // A disordered block (each particle displaced by up to 0.15 dp), so the passive particles' SPH volumes differ

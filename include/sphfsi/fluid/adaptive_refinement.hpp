@@ -41,8 +41,10 @@
 // a passive one, one that becomes passive or is removed takes its mass away. The mass account (conserve_mass) hands
 // the active mass a pass changed back to the active particles within transition_width of a box edge, each scaled by
 // 1 + dM / M_edge, so the active fluid mass is conserved to round-off over every pass; the largest |dM / M_edge| is
-// reported (AdaptiveRefinementCounts::mass_correction). Momentum is not corrected: it changes by the momentum the
-// status changes carry (measured in docs/variable-resolution.md). The model keeps no state a restart needs (levels
+// reported (AdaptiveRefinementCounts::mass_correction). The momentum account (conserve_momentum) then hands the
+// active momentum the pass changed (the status changes and the mass account's rescaling carry momentum) back to the
+// same particles as one velocity shift dP / M_edge, so the active momentum is conserved to round-off too; the largest
+// shift is reported (AdaptiveRefinementCounts::momentum_correction). The model keeps no state a restart needs (levels
 // are smoothing lengths, passive flags and masses are particle fields). One global time step, set by the finest
 // particles.
 //
@@ -86,6 +88,9 @@ struct AdaptiveRefinementParameters {
   /// Whether each pass hands the active mass it changed back to the active particles near the box edges (the mass
   /// account of the header comment), so that the active mass is conserved to round-off.
   bool conserve_mass{true};
+  /// Whether each pass also hands the active momentum it changed back to the active particles near the box edges,
+  /// as one velocity shift dP / M_edge, so that the active momentum is conserved to round-off too.
+  bool conserve_momentum{true};
   /// Whether a passive particle is interpolated from the active particles of its own level too (h_ab = h_a), not
   /// only from those of the other levels: near a box edge the other level is active on one side only, its own on the
   /// other, so the stencil is two-sided.
@@ -122,6 +127,8 @@ struct AdaptiveRefinementCounts {
   /// Largest relative mass change of the mass account: the active mass the statuses changed over the active mass of
   /// the particles near the box edges that took it back (0 without conserve_mass).
   double mass_correction{0};
+  /// Largest velocity shift of the momentum account, |dP| / M_edge, m/s (0 without conserve_momentum).
+  double momentum_correction{0};
 };
 
 /// Adaptive particle refinement with overlapping resolutions (see the header comment). A ParticleModel: it adds no
@@ -263,6 +270,7 @@ class AdaptiveRefinement {
     total_.deactivated += c.deactivated;
     total_.uninterpolated += c.uninterpolated;
     total_.mass_correction = std::max(total_.mass_correction, c.mass_correction);
+    total_.momentum_correction = std::max(total_.momentum_correction, c.momentum_correction);
   }
 
   T active_mass(const System& system) const { return active_mass_momentum(system).first; }
@@ -272,22 +280,40 @@ class AdaptiveRefinement {
     return highest_level(x, params_.transition_width) != highest_level(x, -params_.transition_width);
   }
 
+  // The active fluid particles within transition_width of a box edge, into edge_.
+  void collect_edge(const System& system) {
+    const auto& p = system.particles();
+    edge_.clear();
+    for (std::size_t a = 0; a < p.size(); ++a)
+      if (p.kind[a] == Kind::fluid && !p.passive[a] && near_box_edge(p.position[a])) edge_.push_back(a);
+  }
+
   // The mass account: the active mass a pass changed (particles that became passive or active, with the masses
   // they carried) is handed back to the active particles near the box edges in proportion to their masses.
   void balance_mass(System& system, T changed, AdaptiveRefinementCounts& counts) {
     if (changed == T(0)) return;
     auto& p = system.particles();
-    edge_.clear();
     T band = T(0);
-    for (std::size_t a = 0; a < p.size(); ++a) {
-      if (p.kind[a] != Kind::fluid || p.passive[a] || !near_box_edge(p.position[a])) continue;
-      edge_.push_back(a);
-      band += p.mass[a];
-    }
+    collect_edge(system);
+    for (std::size_t a : edge_) band += p.mass[a];
     if (!(band > T(0))) return;
     const T factor = T(1) + changed / band;
     for (std::size_t a : edge_) p.mass[a] *= factor;
     counts.mass_correction = std::abs(static_cast<double>(changed / band));
+  }
+
+  // The momentum account: the active momentum a pass changed (status changes, the mass account's rescaling) is
+  // handed back to the active particles near the box edges as one velocity shift dP / M_edge.
+  void balance_momentum(System& system, const Vector& changed, AdaptiveRefinementCounts& counts) {
+    if (changed.squaredNorm() == T(0)) return;
+    auto& p = system.particles();
+    T band = T(0);
+    collect_edge(system);
+    for (std::size_t a : edge_) band += p.mass[a];
+    if (!(band > T(0))) return;
+    const Vector shift = changed / band;
+    for (std::size_t a : edge_) p.velocity[a] += shift;
+    counts.momentum_correction = static_cast<double>(shift.norm());
   }
 
   // Mass of a particle of level k: rho0 (dp / 2^k)^Dim (the scene's base particles have rho0 dp^Dim).
@@ -298,12 +324,13 @@ class AdaptiveRefinement {
   // interpolated. initial_level >= 0 (populate): the particles of that level make their children, in the boxes too.
   AdaptiveRefinementCounts pass(System& system, int initial_level, T time) {
     auto& p = system.particles();
-    const T rho0 = system.eos().reference_density();
     const std::size_t n = p.size();
     AdaptiveRefinementCounts counts;
     const std::size_t children = std::size_t(1) << Dim;
     const bool account = initial_level < 0 && params_.conserve_mass;
-    const T mass_before = account ? active_mass(system) : T(0);
+    const bool momentum_account = initial_level < 0 && params_.conserve_momentum;
+    const auto before =
+        account || momentum_account ? active_mass_momentum(system) : std::pair{T(0), Vector::Zero().eval()};
     // 1. Statuses; particles finer than every box within transition_width of them are removed.
     level_.assign(n, 0);
     leaving_.assign(n, 0);
@@ -393,7 +420,8 @@ class AdaptiveRefinement {
       });
     }
     interpolate_passive(system, counts);
-    if (account) balance_mass(system, mass_before - active_mass(system), counts);
+    if (account) balance_mass(system, before.first - active_mass(system), counts);
+    if (momentum_account) balance_momentum(system, before.second - active_mass_momentum(system).second, counts);
     return counts;
   }
 
