@@ -224,15 +224,14 @@ int main(int argc, char** argv) try {
     auto write_counts = [&](double t) {
       const auto& p = system.particles();
       std::size_t n = 0, level[2] = {0, 0};
+      double kinetic = 0;
       for (std::size_t i = 0; i < p.size(); ++i) {
         if (p.kind[i] != Kind::fluid) continue;
         ++n;
         ++level[std::min(level_of(i), 1)];
+        if (integrated(i)) kinetic += 0.5 * p.mass[i] * p.velocity[i].squaredNorm();
       }
       const auto [made, unmade] = created_removed();
-      double kinetic = 0;
-      for (std::size_t i = 0; i < p.size(); ++i)
-        if (integrated(i)) kinetic += 0.5 * p.mass[i] * p.velocity[i].squaredNorm();
       counts_csv.write_row(
           {t, double(n), double(level[0]), double(level[1]), (fluid_mass() - mass0) / mass0, made, unmade, kinetic});
     };

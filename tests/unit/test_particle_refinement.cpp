@@ -400,6 +400,28 @@ struct AprBlock {
                                1.3 * dp);
     system.update_pressure();
   }
+  // Displaces each particle by up to 0.15 dp (deterministically), so the passive particles' SPH volumes differ from
+  // the nominal ones and a status change moves mass; a perfect lattice would hand over whole columns exactly.
+  void disorder() {
+    auto& p = system.particles();
+    for (std::size_t i = 0; i < p.size(); ++i)
+      p.position[i] += 0.15 * dp * V2(std::sin(12.9898 * double(i)), std::cos(78.233 * double(i)));
+  }
+  // 20 passes of apr with the particles moved by dt v between them (no forces); on_pass() after each. Returns the
+  // number of status changes (activations, deactivations, removals).
+  template <class Refinement, class F>
+  std::size_t drift(Refinement& apr, double dt, F&& on_pass) {
+    auto& p = system.particles();
+    std::size_t changes = 0;
+    for (int step = 0; step < 20; ++step) {
+      for (std::size_t i = 0; i < p.size(); ++i) p.position[i] += dt * p.velocity[i];
+      system.update_neighbors((step + 1) * dt);
+      apr.advance(system, step * dt, dt);
+      on_pass();
+      changes += apr.last_counts().activated + apr.last_counts().deactivated + apr.last_counts().removed;
+    }
+    return changes;
+  }
 };
 
 }  // namespace
@@ -687,25 +709,17 @@ TEST_CASE("adaptive refinement: the momentum account conserves the active moment
     block.params.conserve_momentum = conserve;
     auto& p = block.system.particles();
     const auto shear = [](const V2& x) { return V2(0.5 + 2 * (x[1] - 0.08), 0); };
-    for (std::size_t i = 0; i < p.size(); ++i) {
-      p.position[i] += 0.15 * AprBlock::dp * V2(std::sin(12.9898 * double(i)), std::cos(78.233 * double(i)));
-      p.velocity[i] = shear(p.position[i]);
-    }
+    block.disorder();
+    for (std::size_t i = 0; i < p.size(); ++i) p.velocity[i] = shear(p.position[i]);
     Apr apr(block.system.domain(), block.boxes, block.params);
     apr.populate(block.system);
     const auto [mass0, momentum0] = apr.active_mass_momentum(block.system);
-    const double dt = 0.4 * AprBlock::dp;  // 0.2 dp per pass at 0.5 m/s
     double worst_mass = 0, worst_momentum = 0;
-    std::size_t changes = 0;
-    for (int step = 0; step < 20; ++step) {
-      for (std::size_t i = 0; i < p.size(); ++i) p.position[i] += dt * p.velocity[i];
-      block.system.update_neighbors((step + 1) * dt);
-      apr.advance(block.system, step * dt, dt);
+    const std::size_t changes = block.drift(apr, 0.4 * AprBlock::dp, [&] {  // 0.2 dp per pass at 0.5 m/s
       const auto [mass, momentum] = apr.active_mass_momentum(block.system);
       worst_mass = std::max(worst_mass, std::abs(mass - mass0) / mass0);
       worst_momentum = std::max(worst_momentum, (momentum - momentum0).norm() / momentum0.norm());
-      changes += apr.last_counts().activated + apr.last_counts().deactivated + apr.last_counts().removed;
-    }
+    });
     INFO("conserve_momentum " << conserve << ": largest |dP| / |P0| " << worst_momentum << ", largest velocity shift "
                               << apr.total_counts().momentum_correction << " m/s, status changes " << changes);
     CHECK(changes > 0);
@@ -731,27 +745,17 @@ TEST_CASE("adaptive refinement: the mass account conserves the active mass to ro
     block.params.conserve_momentum = false;  // the mass account alone (momentum M u holds with the mass kept)
     auto& p = block.system.particles();
     const V2 u(0.5, 0);
-    // A disordered block (each particle displaced by up to 0.15 dp), so the passive particles' SPH volumes differ
-    // from the nominal ones and a status change moves mass; a perfect lattice would hand over whole columns exactly.
-    for (std::size_t i = 0; i < p.size(); ++i) {
-      p.velocity[i] = u;
-      p.position[i] += 0.15 * AprBlock::dp * V2(std::sin(12.9898 * double(i)), std::cos(78.233 * double(i)));
-    }
+    block.disorder();
+    for (std::size_t i = 0; i < p.size(); ++i) p.velocity[i] = u;
     const double mass0 = fluid_totals(p).mass;
     Apr apr(block.system.domain(), block.boxes, block.params);
     apr.populate(block.system);
-    const double dt = 0.2 * AprBlock::dp / u[0];
     double worst_mass = 0, worst_momentum = 0;
-    std::size_t changes = 0;
-    for (int step = 0; step < 20; ++step) {
-      for (std::size_t i = 0; i < p.size(); ++i) p.position[i] += dt * p.velocity[i];
-      block.system.update_neighbors((step + 1) * dt);
-      apr.advance(block.system, step * dt, dt);
+    const std::size_t changes = block.drift(apr, 0.2 * AprBlock::dp / u[0], [&] {
       const auto [mass, momentum] = apr.active_mass_momentum(block.system);
       worst_mass = std::max(worst_mass, std::abs(mass - mass0) / mass0);
       worst_momentum = std::max(worst_momentum, (momentum - mass * u).norm() / (mass * u.norm()));
-      changes += apr.last_counts().activated + apr.last_counts().deactivated + apr.last_counts().removed;
-    }
+    });
     INFO("conserve_mass " << conserve << ": largest |dM| / M " << worst_mass << ", largest correction "
                           << apr.total_counts().mass_correction << ", status changes " << changes);
     CHECK(changes > 0);

@@ -273,45 +273,40 @@ class AdaptiveRefinement {
     total_.momentum_correction = std::max(total_.momentum_correction, c.momentum_correction);
   }
 
-  T active_mass(const System& system) const { return active_mass_momentum(system).first; }
-
   // Whether x lies within transition_width of a box edge (on either side): the band where statuses change.
   bool near_box_edge(const Vector& x) const {
     return highest_level(x, params_.transition_width) != highest_level(x, -params_.transition_width);
   }
 
-  // The active fluid particles within transition_width of a box edge, into edge_.
-  void collect_edge(const System& system) {
-    const auto& p = system.particles();
+  // The mass and momentum accounts: the active mass (with conserve_mass) and momentum (with conserve_momentum) a pass
+  // changed, the particles that became passive or active carrying them, go back to the active particles near the
+  // box edges: each mass scaled by 1 + dM / M_edge, then one velocity shift dP / M_edge for the momentum still
+  // missing (the changes' and the rescaling's).
+  void balance(System& system, const std::pair<T, Vector>& before, AdaptiveRefinementCounts& counts) {
+    auto& p = system.particles();
+    const auto [mass, momentum] = active_mass_momentum(system);
+    const T mass_change = params_.conserve_mass ? before.first - mass : T(0);
+    Vector momentum_change = before.second - momentum;
+    if (mass_change == T(0) && (!params_.conserve_momentum || momentum_change.squaredNorm() == T(0))) return;
     edge_.clear();
-    for (std::size_t a = 0; a < p.size(); ++a)
-      if (p.kind[a] == Kind::fluid && !p.passive[a] && near_box_edge(p.position[a])) edge_.push_back(a);
-  }
-
-  // The mass account: the active mass a pass changed (particles that became passive or active, with the masses
-  // they carried) is handed back to the active particles near the box edges in proportion to their masses.
-  void balance_mass(System& system, T changed, AdaptiveRefinementCounts& counts) {
-    if (changed == T(0)) return;
-    auto& p = system.particles();
     T band = T(0);
-    collect_edge(system);
-    for (std::size_t a : edge_) band += p.mass[a];
+    for (std::size_t a = 0; a < p.size(); ++a) {
+      if (p.kind[a] != Kind::fluid || p.passive[a] || !near_box_edge(p.position[a])) continue;
+      edge_.push_back(a);
+      band += p.mass[a];
+    }
     if (!(band > T(0))) return;
-    const T factor = T(1) + changed / band;
-    for (std::size_t a : edge_) p.mass[a] *= factor;
-    counts.mass_correction = std::abs(static_cast<double>(changed / band));
-  }
-
-  // The momentum account: the active momentum a pass changed (status changes, the mass account's rescaling) is
-  // handed back to the active particles near the box edges as one velocity shift dP / M_edge.
-  void balance_momentum(System& system, const Vector& changed, AdaptiveRefinementCounts& counts) {
-    if (changed.squaredNorm() == T(0)) return;
-    auto& p = system.particles();
-    T band = T(0);
-    collect_edge(system);
-    for (std::size_t a : edge_) band += p.mass[a];
-    if (!(band > T(0))) return;
-    const Vector shift = changed / band;
+    if (mass_change != T(0)) {
+      const T correction = mass_change / band;
+      for (std::size_t a : edge_) {
+        momentum_change -= correction * p.mass[a] * p.velocity[a];  // the rescaling's momentum
+        p.mass[a] *= T(1) + correction;
+      }
+      band += mass_change;
+      counts.mass_correction = std::abs(static_cast<double>(correction));
+    }
+    if (!params_.conserve_momentum || momentum_change.squaredNorm() == T(0)) return;
+    const Vector shift = momentum_change / band;
     for (std::size_t a : edge_) p.velocity[a] += shift;
     counts.momentum_correction = static_cast<double>(shift.norm());
   }
@@ -327,10 +322,8 @@ class AdaptiveRefinement {
     const std::size_t n = p.size();
     AdaptiveRefinementCounts counts;
     const std::size_t children = std::size_t(1) << Dim;
-    const bool account = initial_level < 0 && params_.conserve_mass;
-    const bool momentum_account = initial_level < 0 && params_.conserve_momentum;
-    const auto before =
-        account || momentum_account ? active_mass_momentum(system) : std::pair{T(0), Vector::Zero().eval()};
+    const bool account = initial_level < 0 && (params_.conserve_mass || params_.conserve_momentum);
+    const auto before = account ? active_mass_momentum(system) : std::pair{T(0), Vector::Zero().eval()};
     // 1. Statuses; particles finer than every box within transition_width of them are removed.
     level_.assign(n, 0);
     leaving_.assign(n, 0);
@@ -406,7 +399,7 @@ class AdaptiveRefinement {
     std::sort(removals_.begin(), removals_.end(), std::greater<>());
     for (std::size_t slot : removals_) p.remove(slot);
     counts.removed = removals_.size();
-    // 4. Values of the passive particles from the active ones of the other levels, on the new index.
+    // 4. Values of the passive particles from the active ones, on the new index.
     if (counts.created + counts.removed > 0 || initial_level >= 0) system.update_neighbors(time);
     if (initial_level >= 0 && params_.linear_interpolation) {
       // populate: the children's density and velocity fitted from their parents' level (not copied from the parent,
@@ -420,8 +413,7 @@ class AdaptiveRefinement {
       });
     }
     interpolate_passive(system, counts);
-    if (account) balance_mass(system, before.first - active_mass(system), counts);
-    if (momentum_account) balance_momentum(system, before.second - active_mass_momentum(system).second, counts);
+    if (account) balance(system, before, counts);
     return counts;
   }
 
@@ -435,32 +427,34 @@ class AdaptiveRefinement {
     using Values = Eigen::Matrix<T, Dim + 1, Dim + 1>;  // columns: density, velocity components
     auto& p = system.particles();
     const auto& kernel = system.kernel();
-    T weight = T(0), rho = T(0);
-    Vector v = Vector::Zero();
+    // Row 0 of the moment matrix and of the right-hand side are the Shepard sums (sum w, sum w rho, sum w v); only
+    // the linear fit needs the other rows.
+    const bool linear = params_.linear_interpolation;
     Moment moment = Moment::Zero();
     Values rhs = Values::Zero();
     const T scale = T(1) / p.smoothing_length[a];
     system.for_each_neighbor(a, [&](std::size_t b, const Vector& dx, T r, T h) {
       if (!accept(b)) return;
       const T w = p.mass[b] / p.density[b] * kernel.value(r, h);
-      weight += w;
-      rho += w * p.density[b];
-      v += w * p.velocity[b];
-      if (params_.linear_interpolation) {
+      Column f;
+      f[0] = p.density[b];
+      f.template tail<Dim>() = p.velocity[b];
+      if (linear) {
         Column q;
         q[0] = T(1);
         q.template tail<Dim>() = -dx * scale;  // (x_b - x_a) / h_a
         moment.noalias() += w * q * q.transpose();
-        Column f;
-        f[0] = p.density[b];
-        f.template tail<Dim>() = p.velocity[b];
         rhs.noalias() += w * q * f.transpose();
+      } else {
+        moment(0, 0) += w;
+        rhs.row(0) += w * f.transpose();
       }
     });
+    const T weight = moment(0, 0);
     if (!(weight > T(0))) return false;
-    p.velocity[a] = v / weight;
-    p.density[a] = rho / weight;
-    if (params_.linear_interpolation) {
+    p.density[a] = rhs(0, 0) / weight;
+    p.velocity[a] = rhs.row(0).template tail<Dim>().transpose() / weight;
+    if (linear) {
       const Moment normalised = moment / weight;
       if (normalised.determinant() > T(1e-4)) {
         const Values c = normalised.ldlt().solve(rhs / weight);
@@ -473,9 +467,10 @@ class AdaptiveRefinement {
     return true;
   }
 
-  // Shepard interpolation of velocity and density for the passive particles from the active fluid particles of the
-  // other levels within their pair support (the header comment). Reads active particles only and writes passive
-  // ones only, so the slots can be processed in parallel in place.
+  // Velocity and density of the passive particles fitted from the active fluid particles within their pair support
+  // (fit(); the other levels', and with interpolate_from_own_level their own level's too: the header comment), then
+  // their masses. Reads active particles only and writes passive ones only, so the slots can be processed in
+  // parallel in place.
   void interpolate_passive(System& system, AdaptiveRefinementCounts& counts) {
     auto& p = system.particles();
     const auto& kernel = system.kernel();
@@ -491,18 +486,15 @@ class AdaptiveRefinement {
         return p.kind[b] == Kind::fluid && !p.passive[b] &&
                (level_[b] != level_[a] || params_.interpolate_from_own_level);
       });
-      if (!found) {
-        missing_[a] = 1;
-        return;
-      }
+      if (!found) missing_[a] = 1;
     });
+    for (std::uint8_t m : missing_) counts.uninterpolated += m;
     // Passive masses: rho_a / sum_b W_ab over the particles of its level (its SPH volume), at most the nominal
     // mass, so passive particles that bunched up (they follow an interpolated velocity, not their own pressure)
     // do not weigh more in their active neighbours' sums than the fluid they stand for.
     if (!params_.passive_mass_from_volume) {
       for (std::size_t a = 0; a < n; ++a)
         if (p.kind[a] == Kind::fluid && p.passive[a]) p.mass[a] = nominal_mass(level_[a], rho0);
-      for (std::uint8_t m : missing_) counts.uninterpolated += m;
       return;
     }
     parallel_for(n, [&](std::size_t a) {
@@ -516,7 +508,6 @@ class AdaptiveRefinement {
       p.mass[a] = nominal_mass(level_[a], rho0) *
                   std::min(T(1), lattice_number_density_ / (number_density * std::pow(spacing, T(Dim))));
     });
-    for (std::uint8_t m : missing_) counts.uninterpolated += m;
   }
 
   void check_walls(const System& system) const {
@@ -560,7 +551,7 @@ class AdaptiveRefinement {
   T lattice_number_density_{1};        // lattice_number_density() of the kernel (populate)
   std::vector<std::size_t> removals_;  // slots to remove
   std::vector<Child> created_;         // children to create
-  std::vector<std::size_t> edge_;      // slots of the active particles near a box edge (the mass account)
+  std::vector<std::size_t> edge_;      // slots of the active particles near a box edge (the accounts)
 };
 
 }  // namespace sphfsi
