@@ -455,6 +455,44 @@ TEST_CASE("blade drag: nodes above the free surface exchange nothing; 30 coupled
   check_momentum_over_steps(sim, moving);
 }
 
+TEST_CASE("blade drag: passive fluid particles (a refined region's other resolution) are left out",
+          "[coupling][thin]") {
+  // The drag of a uniform stream, then the same block with a passive copy of every fluid particle, offset by half a
+  // spacing and moving against the stream: the blade's force and the active fluid's reaction are unchanged, and the
+  // passive particles receive nothing (fluid/adaptive_refinement.hpp sets their velocity; the drag acts on the
+  // integrated fluid).
+  const double U = 0.2;
+  System system = blade_in_block(0.1);
+  auto& p = system.particles();
+  for (std::size_t i = 0; i < p.size(); ++i) p.velocity[i] = p.kind[i] == Kind::fluid ? V(U, 0) : V::Zero();
+  drag_only(system, BladeDrag<double>{});
+  std::vector<V> alone(p.id_capacity(), V::Zero());
+  for (std::size_t i = 0; i < p.size(); ++i) alone[p.id[i]] = p.acceleration[i];
+  const std::size_t n = p.size();
+  REQUIRE(p.count(Kind::wall) == 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (p.kind[i] != Kind::fluid) continue;
+    const std::size_t c = p.add(Kind::fluid, V(p.position[i] + V(0.0025, 0.0025)), V(-U, 0.3), p.density[i], p.mass[i],
+                                p.smoothing_length[i]);
+    p.passive[c] = 1;
+  }
+  drag_only(system, BladeDrag<double>{});
+  double largest = 0, passive_largest = 0;
+  std::size_t passive = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (p.passive[i]) {
+      ++passive;
+      passive_largest = std::max(passive_largest, p.acceleration[i].norm());
+    } else {
+      largest = std::max(largest, (p.acceleration[i] - alone[p.id[i]]).norm() / (alone[p.id[i]].norm() + 1e-30));
+      if (p.kind[i] == Kind::solid) CHECK(alone[p.id[i]].norm() > 0);
+    }
+  }
+  CHECK(passive == n - p.count(Kind::solid));  // one copy per fluid particle
+  CHECK(largest <= 1e-12);
+  CHECK(passive_largest == 0.0);
+}
+
 TEST_CASE("blade drag: bad coefficients are rejected with the valid range", "[coupling][thin]") {
   BladeDrag<double> drag;
   drag.drag_coefficient = -1;

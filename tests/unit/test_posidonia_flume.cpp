@@ -401,3 +401,75 @@ TEST_CASE("posidonia drag plants: porous rows of real leaves, C_D from the incid
   CHECK_THROWS_WITH(scenes::add_posidonia_drag_blades(other, bad, other_layout),
                     Catch::Contains("not BladeModel::drag"));
 }
+
+TEST_CASE("posidonia drag plants in a refined box: the box on the base lattice, the fine bed, fine nodes, bad input",
+          "[posidonia][apr]") {
+  scenes::PosidoniaFlume<double> s;
+  s.particles_per_depth = 10;  // dp = 2 cm, h = 2 dp
+  s.absorber_start = 1.8;
+  s.refinement.enabled = true;
+  s.refinement.margin = 0.12;
+  s.refinement.top = 0.16;
+  s.validate();
+  const double dp = s.dp(), fine = 0.5 * dp;
+  CHECK(s.plant_dp() == fine);
+  const auto boxes = s.refinement_boxes();
+  REQUIRE(boxes.size() == 1);
+  CHECK_THAT(boxes[0].lower[0], WithinRel(1.08, 1e-12));  // plant at 1.2 m, margin 0.12 m, on cell edges i dp
+  CHECK_THAT(boxes[0].upper[0], WithinRel(1.32, 1e-12));
+  CHECK(boxes[0].lower[1] == 0.0);
+  CHECK_THAT(boxes[0].upper[1], WithinRel(0.16, 1e-12));
+  CHECK(boxes[0].level == 1);
+
+  const auto g = s.flume();
+  System system(scenes::wave_flume_domain(g), Tait<double>(1000, g.sound_speed()));
+  const auto layout = scenes::build_posidonia_flume(system, s);
+  auto& p = system.particles();
+  // the fine bed: x in the box and its transition zone (4 dp on each side), as thick as the coarse bed (3 dp)
+  std::size_t fine_wall = 0;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (p.kind[i] == Kind::wall && p.smoothing_length[i] == g.smoothing_ratio * fine) {
+      ++fine_wall;
+      CHECK(p.position[i][1] < 0);
+      CHECK(p.position[i][0] > 1.08 - 4 * dp);
+      CHECK(p.position[i][0] < 1.32 + 4 * dp);
+    }
+  CHECK(fine_wall == std::size_t(std::lround((0.24 + 8 * dp) / fine)) * 6);
+  const auto plants = scenes::add_posidonia_drag_blades(system, s, layout);
+  for (std::uint32_t id : plants.rod(0).particle_ids())
+    CHECK(p.smoothing_length[p.slot_of_id(id)] == g.smoothing_ratio * fine);  // the nodes sample the fine fluid
+  CHECK(plants.rod(0).particle_ids().size() == std::size_t(std::lround(s.blade_length() / (0.5 * fine))) + 1);
+
+  // The adaptive refinement finds the fine bed and fills the box with four fine particles per coarse one.
+  AdaptiveRefinement<System> apr(system.domain(), boxes, s.adaptive_refinement_parameters());
+  const std::size_t coarse_in_box = [&] {
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) n += p.kind[i] == Kind::fluid && boxes[0].contains(p.position[i]);
+    return n;
+  }();
+  apr.populate(system);
+  std::size_t fine_active = 0, coarse_passive = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (p.kind[i] != Kind::fluid || !boxes[0].contains(p.position[i])) continue;
+    if (apr.level_of(p.smoothing_length[i]) == 1 && !p.passive[i]) ++fine_active;
+    if (apr.level_of(p.smoothing_length[i]) == 0) coarse_passive += p.passive[i];
+  }
+  CHECK(coarse_passive == coarse_in_box);
+  CHECK(fine_active == 4 * coarse_in_box);
+
+  auto bad = s;
+  bad.blade = scenes::BladeModel::rod;
+  CHECK_THROWS_WITH(bad.validate(), Catch::Contains("refinement") && Catch::Contains("drag blade"));
+  bad = s;
+  bad.plants = 0;
+  CHECK_THROWS_WITH(bad.validate(), Catch::Contains("refinement"));
+  bad = s;
+  bad.refinement.margin = 0.05;  // below 6 dp: the tip's sway and the nodes' support would leave the box
+  CHECK_THROWS_WITH(bad.validate(), Catch::Contains("refinement.margin"));
+  bad = s;
+  bad.refinement.top = 0.1;  // below l + 4 dp
+  CHECK_THROWS_WITH(bad.validate(), Catch::Contains("refinement.top"));
+  bad = s;
+  bad.refinement.transition_spacings = 1;
+  CHECK_THROWS_WITH(bad.validate(), Catch::Contains("transition_spacings") && Catch::Contains("[2, 10]"));
+}

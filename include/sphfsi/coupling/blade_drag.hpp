@@ -22,7 +22,9 @@
 // & Nepf (2016, J. Fluids Struct. 61:20), who also include the added-mass force (here the rod's added inertia,
 // ElasticRodParameters::added_mass_per_area; the force of the fluid's own acceleration is not included) and a
 // Keulegan-Carpenter dependent C_D (analysis/vegetation_drag.hpp: oscillatory_plate_drag_coefficient). A node with no
-// fluid in its support (above the free surface) exchanges nothing.
+// fluid in its support (above the free surface) exchanges nothing. Passive fluid particles (a refined region,
+// fluid/adaptive_refinement.hpp) are left out of u_f and get no reaction: the drag acts on the integrated fluid,
+// which around a node inside a refinement box is its fine resolution only.
 //
 // Limits: it needs a thin structure (one line of nodes with published normals, solid/elastic_rod.hpp). It does not
 // keep the fluid on one side of the blade (crossings are the point here), so it is not the coupling for a blade
@@ -133,7 +135,7 @@ struct BladeDrag {
       p.acceleration[node] += force / p.mass[node];
       const Vec<2, T> per_weight = (frontal_fraction / s.weight_sum) * force;
       system.for_each_neighbor(node, [&](std::size_t f, const Vec<2, T>&, T r, T h) {
-        if (p.kind[f] != Kind::fluid) return;
+        if (p.kind[f] != Kind::fluid || p.passive[f]) return;
         const T w = p.mass[f] / p.density[f] * kernel.value(r, h);
         p.acceleration[f] -= (w / p.mass[f]) * per_weight;
       });
@@ -162,7 +164,7 @@ struct BladeDrag {
     if (k > 0) s.length += T(0.5) * (p.position[node] - p.position[p.slot_of_id(ids[k - 1])]).norm();
     if (k + 1 < ids.size()) s.length += T(0.5) * (p.position[p.slot_of_id(ids[k + 1])] - p.position[node]).norm();
     system.for_each_neighbor(node, [&](std::size_t f, const Vec<2, T>&, T r, T h) {
-      if (p.kind[f] != Kind::fluid) return;
+      if (p.kind[f] != Kind::fluid || p.passive[f]) return;
       const T w = p.mass[f] / p.density[f] * kernel.value(r, h);
       s.weight_sum += w;
       s.fluid_velocity += w * p.velocity[f];

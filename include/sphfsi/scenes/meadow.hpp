@@ -450,8 +450,9 @@ class BladeCrossingCounter {
 };
 
 /// The water beside a point (a blade's tip): the fluid particles within `radius` of `centre` when constructed,
-/// followed by id. mean_displacement() is their mean displacement since then: a passive blade cannot move further
-/// than the water around it.
+/// followed by id (active ones only: a passive particle stands for water another resolution carries).
+/// mean_displacement() is their mean displacement since then, over those not removed since (a refined particle that
+/// left its region): a passive blade cannot move further than the water around it.
 template <class System>
 class FluidTracers {
  public:
@@ -462,7 +463,7 @@ class FluidTracers {
     require_positive("FluidTracers radius (m)", radius);
     const auto& p = system.particles();
     for (std::size_t i = 0; i < p.size(); ++i)
-      if (p.kind[i] == Kind::fluid && (p.position[i] - centre).norm() < radius) {
+      if (p.kind[i] == Kind::fluid && !p.passive[i] && (p.position[i] - centre).norm() < radius) {
         ids_.push_back(p.id[i]);
         start_.push_back(p.position[i]);
       }
@@ -473,8 +474,14 @@ class FluidTracers {
   Vector mean_displacement(const System& system) const {
     const auto& p = system.particles();
     Vector d = Vector::Zero();
-    for (std::size_t k = 0; k < ids_.size(); ++k) d += p.position[p.slot_of_id(ids_[k])] - start_[k];
-    return ids_.empty() ? d : Vector(d / T(ids_.size()));
+    std::size_t n = 0;
+    for (std::size_t k = 0; k < ids_.size(); ++k) {
+      const auto slot = p.slot_of_id(ids_[k]);
+      if (slot == System::Particles::no_slot) continue;  // removed (left a refined region)
+      d += p.position[slot] - start_[k];
+      ++n;
+    }
+    return n == 0 ? d : Vector(d / T(n));
   }
 
  private:

@@ -44,6 +44,7 @@
 #include <sphfsi/analysis/vegetation_drag.hpp>
 #include <sphfsi/core/error.hpp>
 #include <sphfsi/core/particle_system.hpp>
+#include <sphfsi/fluid/adaptive_refinement.hpp>
 #include <sphfsi/scenes/builders.hpp>
 #include <sphfsi/scenes/meadow.hpp>
 #include <sphfsi/scenes/wave_flume.hpp>
@@ -57,6 +58,22 @@
 namespace sphfsi::scenes {
 
 enum class BladeModel { equivalent, scaled, rod, drag };
+
+/// Fine fluid around the plants only (issue 9 part 4): one level-1 box (spacing dp / 2) of adaptive particle
+/// refinement (fluid/adaptive_refinement.hpp) from the bed up to `top`, from `margin` before the first plant to
+/// `margin` after the last, its ends on the base lattice's cell edges. The bed under the box and its transition zone is
+/// built again at dp / 2 beside the coarse one (each resolution sees only its own walls), and the drag blades' nodes
+/// take the fine spacing and smoothing length. Only the porous drag blades (BladeModel::drag) are supported: their
+/// coupling acts on the active fluid only (coupling/blade_drag.hpp); the impermeable couplings would see the fluid of
+/// both resolutions.
+template <Real T>
+struct PlantRefinement {
+  bool enabled{false};
+  T margin{T(0.1)};             ///< box extent beyond the first and the last plant, m
+  T top{T(0)};                  ///< box top above the bed, m (0: above the crests, the free surface inside the box)
+  T transition_spacings{T(4)};  ///< width of the transition zone around the box / dp, [2, 10]
+  T bunched_fraction{T(0.3)};   ///< AdaptiveRefinementParameters::bunched_fraction
+};
 
 /// The Posidonia flume: waves, resolution, plants and blade model (lengths in m).
 template <Real T>
@@ -99,6 +116,8 @@ struct PosidoniaFlume {
   /// drag blade: share phi of the flume's width the leaves of one plant cover (1: a full row; one shoot of n leaves
   /// in a flume of width W: n b / W), (0, 1] (coupling/blade_drag.hpp)
   T frontal_fraction{T(1)};
+  /// fine fluid around the plants (off by default: the whole flume at dp)
+  PlantRefinement<T> refinement{};
 
   void validate() const {
     require_positive("PosidoniaFlume::depth (m)", depth);
@@ -135,9 +154,47 @@ struct PosidoniaFlume {
                          T(2) * dp(), T(10) * depth);
       require_in_range("PosidoniaFlume last plant x (m)", last, first_plant_x, absorber_start);
     }
+    if (refinement.enabled) {
+      if (blade != BladeModel::drag || plants < 1)
+        throw InputError(
+            "PosidoniaFlume::refinement needs plants with the porous drag blade (BladeModel::drag): the other "
+            "couplings would see the fluid of both resolutions");
+      require_in_range("PosidoniaFlume::refinement.transition_spacings (transition width / dp)",
+                       refinement.transition_spacings, T(2), T(10));
+      // the nodes' kernel support (2 h at dp / 2: 2 dp with the flume's h = 2 dp) and the tips' sway stay in the box
+      require_in_range("PosidoniaFlume::refinement.margin (m)", refinement.margin, T(6) * dp(),
+                       absorber_start - (first_plant_x + T(plants - 1) * spacing));
+      require_in_range("PosidoniaFlume::refinement.margin (m, the box must start downstream of the paddle)",
+                       first_plant_x - refinement.margin, (refinement.transition_spacings + T(4)) * dp(),
+                       absorber_start);
+      if (refinement.top != T(0))
+        require_in_range("PosidoniaFlume::refinement.top (m above the bed; 0: above the crests)", refinement.top,
+                         blade_length() + T(4) * dp(), depth - T(2) * dp());
+    }
   }
 
   T dp() const { return depth / particles_per_depth; }
+  /// The fluid spacing around the plants, where the blades' nodes sample the fluid: dp / 2 with refinement, else dp.
+  T plant_dp() const { return refinement.enabled ? T(0.5) * dp() : dp(); }
+  /// The refinement box (empty without refinement): see PlantRefinement.
+  std::vector<RefinementBox<2, T>> refinement_boxes() const {
+    if (!refinement.enabled) return {};
+    const auto x = plant_x();
+    const T d = dp();
+    const T x0 = std::round((x.front() - refinement.margin) / d) * d;
+    const T x1 = std::round((x.back() + refinement.margin) / d) * d;
+    const T z1 = refinement.top > T(0) ? std::round(refinement.top / d) * d : flume().wall_height();
+    return {{Vec<2, T>(x0, T(0)), Vec<2, T>(x1, z1), 1}};
+  }
+  /// The adaptive refinement's parameters for refinement_boxes().
+  AdaptiveRefinementParameters<T> adaptive_refinement_parameters() const {
+    AdaptiveRefinementParameters<T> a;
+    a.base_spacing = dp();
+    a.transition_width = refinement.transition_spacings * dp();
+    a.smoothing_ratio = flume().smoothing_ratio;
+    a.bunched_fraction = refinement.bunched_fraction;
+    return a;
+  }
   /// The real blade as a line of rod nodes (rod, drag), not a continuum of particle rows (scaled, equivalent).
   bool thin_blade() const { return blade == BladeModel::rod || blade == BladeModel::drag; }
   /// t_m, m (the rods: the real thickness)
@@ -258,6 +315,18 @@ PosidoniaLayout<typename System::scalar_type> build_posidonia_flume(
   const Resolution<T> res{dp, g.smoothing_ratio};
   const auto material = scene.blade_material();
   const T mass = material.density * dp * dp;
+  if (scene.refinement.enabled) {
+    // the bed under the box and its transition zone at the fine spacing, as thick as the coarse bed beside it
+    const T fine = scene.plant_dp(), margin = scene.refinement.transition_spacings * dp;
+    const auto box = scene.refinement_boxes().front();
+    const T rho0 = system.eos().reference_density();
+    for_each_lattice_point<2, T>(V(box.lower[0] - margin, -T(g.wall_layers) * dp), V(box.upper[0] + margin, T(0)), fine,
+                                 [&](const V& x) {
+                                   system.particles().add(Kind::wall, x, V::Zero(), rho0, rho0 * fine * fine,
+                                                          g.smoothing_ratio * fine, out.flume.wall_body);
+                                 });
+    set_hydrostatic_wall_density(system, scene.depth, g.wave.gravity);
+  }
   if (scene.thin_blade()) return out;
   for (T xc : out.plant_x) {
     std::vector<std::uint32_t> tip;
@@ -311,8 +380,8 @@ RodBlades<System, BladeDrag<typename System::scalar_type>> add_posidonia_drag_bl
   how.blade_width = scene.leaf_width;
   how.added_mass_coefficient = scene.added_mass_coefficient;
   how.gravity = g.wave.gravity;
-  return add_drag_blades(system, layout.plant_x, T(0), scene.rod_blade(), scene.dp(), g.smoothing_ratio * scene.dp(),
-                         layout.plant_body, how);
+  return add_drag_blades(system, layout.plant_x, T(0), scene.rod_blade(), scene.plant_dp(),
+                         g.smoothing_ratio * scene.plant_dp(), layout.plant_body, how);
 }
 
 }  // namespace sphfsi::scenes

@@ -29,7 +29,7 @@ namespace sphfsi::waves {
 
 /// Free-surface elevation above `still_level` at horizontal position x (vertical axis Dim - 1, gauge line along it,
 /// other horizontal coordinates ignored: for 2D flumes). `dp` sets the sampling step (dp / 4). Returns NaN where
-/// no fluid is within a kernel support of the line.
+/// no fluid is within a kernel support of the line. Passive particles (fluid/adaptive_refinement.hpp) are left out.
 template <class System>
 typename System::scalar_type free_surface_elevation(const System& system, typename System::scalar_type x,
                                                     typename System::scalar_type still_level,
@@ -46,7 +46,7 @@ typename System::scalar_type free_surface_elevation(const System& system, typena
   std::vector<Near> near;
   T z_top = -std::numeric_limits<T>::max(), z_bottom = std::numeric_limits<T>::max();
   for (std::size_t i = 0; i < p.size(); ++i) {
-    if (p.kind[i] != Kind::fluid) continue;
+    if (p.kind[i] != Kind::fluid || p.passive[i]) continue;  // passive: a second resolution of the same water
     const T dx = p.position[i][0] - x, h = p.smoothing_length[i];
     if (std::abs(dx) >= support * h) continue;
     near.push_back({dx, p.position[i][Dim - 1], p.mass[i] / p.density[i], h});
