@@ -49,8 +49,10 @@
 // particles.
 //
 // Walls: a box that comes within a kernel support of a wall needs wall particles at its own spacing there (the scene
-// adds them beside the coarse ones; each resolution sees only its own); populate() checks it. Solids and couplings
-// are not supported inside the boxes or their transition zones (a coupling would see both resolutions).
+// adds them beside the coarse ones; each resolution sees only its own); populate() checks it. Couplings: the porous
+// blade drag (coupling/blade_drag.hpp) acts on the active fluid only, so its blades may stand inside a box (away from
+// its edges: scenes::PlantRefinement); the impermeable couplings and continuum solids are not supported inside the
+// boxes or their transition zones (they would see the fluid of both resolutions).
 #pragma once
 
 #include <sphfsi/core/domain.hpp>

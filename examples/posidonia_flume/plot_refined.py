@@ -1,0 +1,43 @@
+"""Fine fluid around the plant only (issue 9 part 4): the refined run against the uniformly fine and the uniformly
+coarse runs of examples/posidonia_flume: H at the gauges, the tip's dx(t) and dz(t).
+
+Usage: plot_refined.py PNG LABEL=FOLDER ...   (each FOLDER an --output of posidonia_flume with a plants run;
+reads FOLDER/plants/wave_heights.csv and FOLDER/plants/tips.csv)"""
+import csv
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+
+
+def read(path):
+    with open(path) as f:
+        rows = [r for r in csv.reader(line for line in f if not line.startswith("#"))]
+    header, data = rows[0], rows[1:]
+    return {name: [float(r[i]) for r in data] for i, name in enumerate(header)}
+
+
+png = sys.argv[1]
+runs = [a.split("=", 1) for a in sys.argv[2:]]
+fig, (ax_h, ax_x, ax_z) = plt.subplots(3, 1, figsize=(9, 10))
+reference = read(f"{runs[0][1]}/plants/wave_heights.csv")
+for label, folder in runs:
+    h = read(f"{folder}/plants/wave_heights.csv")
+    ax_h.plot(h["x"], [100 * (a / b - 1) for a, b in zip(h["H"], reference["H"])], "o-", label=label)
+    tips = read(f"{folder}/plants/tips.csv")
+    ax_x.plot(tips["t"], [1e3 * v for v in tips["dx_0"]], lw=1, label=label)
+    ax_z.plot(tips["t"], [1e3 * v for v in tips["dz_0"]], lw=1, label=label)
+ax_h.axhspan(-2, 2, color="0.9", label="criterion 2 %")
+ax_h.set_xlabel("gauge x (m)")
+ax_h.set_ylabel(f"H / H({runs[0][0]}) - 1 (%)")
+ax_h.legend(fontsize=8)
+ax_x.set_ylabel("tip dx (mm)")
+ax_z.set_ylabel("tip dz (mm)")
+ax_z.set_xlabel("t (s)")
+ax_x.legend(fontsize=8)
+fig.suptitle("Posidonia flume, one porous real plant (l/h = 0.4): fine fluid around the plant only")
+fig.tight_layout()
+fig.savefig(png, dpi=110)
+print(f"plot: {png}")
