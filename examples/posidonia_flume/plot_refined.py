@@ -20,7 +20,7 @@ def read(path):
 
 
 png = sys.argv[1]
-runs = [a.split("=", 1) for a in sys.argv[2:]]
+runs = [a.rsplit("=", 1) for a in sys.argv[2:]]
 fig, (ax_h, ax_x, ax_z) = plt.subplots(3, 1, figsize=(9, 10))
 reference = read(f"{runs[0][1]}/plants/wave_heights.csv")
 for label, folder in runs:
