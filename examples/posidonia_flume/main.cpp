@@ -12,6 +12,9 @@
 // these resolutions, docs/flume.md, so the plants' effect is the difference of the two runs).
 // Output (--output DIR): DIR/plants and DIR/empty with gauges.csv, wave_heights.csv, (plants) tips.csv and VTK
 // snapshots; DIR/comparison.csv (H at each gauge, both runs) and DIR/posidonia_flume.png. See docs/posidonia.md.
+// --refine on (drag blades, --runs plants): fine fluid (dp / 2) around the plants only, by adaptive particle
+// refinement (scenes::PlantRefinement); --reference DIR compares it with a uniformly fine run in DIR
+// (docs/variable-resolution.md section 4).
 #include <sphfsi/analysis/zero_crossing.hpp>
 #include <sphfsi/coupling/coupled_body.hpp>
 #include <sphfsi/coupling/repulsive_force.hpp>
