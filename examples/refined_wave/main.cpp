@@ -131,11 +131,7 @@ int main(int argc, char** argv) try {
         if (p.kind[i] == Kind::wall && p.body[i] == layout.wall_body && p.position[i][1] < 0 && p.position[i][0] > x0 &&
             p.position[i][0] < x1)
           p.remove(i);
-    const double fine = 0.5 * dp;
-    for_each_lattice_point<2, T>(V2(x0 - margin, -g.wall_layers * dp), V2(x1 + margin, 0), fine, [&](const V2& x) {
-      p.add(Kind::wall, x, V2::Zero(), 1000, 1000 * fine * fine, g.smoothing_ratio * fine, layout.wall_body);
-    });
-    set_hydrostatic_wall_density(system, g.depth(), g.wave.gravity);
+    scenes::add_fine_bed(system, g, x0 - margin, x1 + margin, 0.5 * dp);
   }
   fluid.artificial_viscosity = alpha;
   fluid.wall_artificial_viscosity = wall_viscosity;  // off: the flume's default (docs/flume.md)

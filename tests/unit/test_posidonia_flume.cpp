@@ -435,6 +435,8 @@ TEST_CASE("posidonia drag plants in a refined box: the box on the base lattice, 
       CHECK(p.position[i][0] < 1.32 + 4 * dp);
     }
   CHECK(fine_wall == std::size_t(std::lround((0.24 + 8 * dp) / fine)) * 6);
+  CHECK_THROWS_WITH(scenes::add_fine_bed(system, g, 1.3, 1.1, fine), Catch::Contains("x_to"));
+  CHECK_THROWS_WITH(scenes::add_fine_bed(system, g, 1.1, 1.3, dp), Catch::Contains("add_fine_bed spacing"));
   const auto plants = scenes::add_posidonia_drag_blades(system, s, layout);
   for (std::uint32_t id : plants.rod(0).particle_ids())
     CHECK(p.smoothing_length[p.slot_of_id(id)] == g.smoothing_ratio * fine);  // the nodes sample the fine fluid

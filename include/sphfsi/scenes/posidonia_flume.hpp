@@ -315,17 +315,10 @@ PosidoniaLayout<typename System::scalar_type> build_posidonia_flume(
   const Resolution<T> res{dp, g.smoothing_ratio};
   const auto material = scene.blade_material();
   const T mass = material.density * dp * dp;
-  if (scene.refinement.enabled) {
-    // the bed under the box and its transition zone at the fine spacing, as thick as the coarse bed beside it
-    const T fine = scene.plant_dp(), margin = scene.refinement.transition_spacings * dp;
+  if (scene.refinement.enabled) {  // the bed under the box and its transition zone at the fine spacing
+    const T margin = scene.refinement.transition_spacings * dp;
     const auto box = scene.refinement_boxes().front();
-    const T rho0 = system.eos().reference_density();
-    for_each_lattice_point<2, T>(V(box.lower[0] - margin, -T(g.wall_layers) * dp), V(box.upper[0] + margin, T(0)), fine,
-                                 [&](const V& x) {
-                                   system.particles().add(Kind::wall, x, V::Zero(), rho0, rho0 * fine * fine,
-                                                          g.smoothing_ratio * fine, out.flume.wall_body);
-                                 });
-    set_hydrostatic_wall_density(system, scene.depth, g.wave.gravity);
+    add_fine_bed(system, g, box.lower[0] - margin, box.upper[0] + margin, scene.plant_dp());
   }
   if (scene.thin_blade()) return out;
   for (T xc : out.plant_x) {

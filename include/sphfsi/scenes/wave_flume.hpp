@@ -159,6 +159,30 @@ WaveFlumeLayout<typename System::scalar_type> build_wave_flume(
   return out;
 }
 
+/// The bed from x_from to x_to built again at a finer `spacing`, beside the coarse bed of build_wave_flume and as
+/// thick (wall_layers dp), for a refined region that reaches the bed (fluid/adaptive_refinement.hpp: each resolution
+/// sees only its own walls); wall densities set hydrostatic again, as build_wave_flume does. Returns the particle
+/// count.
+template <class System>
+std::size_t add_fine_bed(System& system, const WaveFlumeGeometry<typename System::scalar_type>& g,
+                         typename System::scalar_type x_from, typename System::scalar_type x_to,
+                         typename System::scalar_type spacing) {
+  using T = typename System::scalar_type;
+  using V = Vec<2, T>;
+  require_in_open_range("add_fine_bed spacing (m)", spacing, T(0), g.dp());
+  if (!(x_to > x_from))
+    throw InputError(fmt::format("add_fine_bed: x_to = {} m must be greater than x_from = {} m", x_to, x_from));
+  const T rho0 = system.eos().reference_density(), mass = rho0 * spacing * spacing;
+  std::size_t added = 0;
+  for_each_lattice_point<2, T>(V(x_from, -T(g.wall_layers) * g.dp()), V(x_to, T(0)), spacing, [&](const V& x) {
+    system.particles().add(Kind::wall, x, V::Zero(), rho0, mass, g.smoothing_ratio * spacing,
+                           WaveFlumeLayout<T>::wall_body);
+    ++added;
+  });
+  set_hydrostatic_wall_density(system, g.depth(), g.wave.gravity);
+  return added;
+}
+
 /// Fluid parameters of the flume: gravity, the artificial viscosity and delta-SPH given (defaults: alpha = 0.01,
 /// delta = 0.1, FluidParameters' defaults), dynamic walls.
 template <Real T>
