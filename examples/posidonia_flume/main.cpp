@@ -120,8 +120,13 @@ scenes::PosidoniaFlume<T> converted(const scenes::PosidoniaFlume<double>& s) {
   c.leaf_width = T(s.leaf_width), c.drag_coefficient = T(s.drag_coefficient);
   c.friction_coefficient = T(s.friction_coefficient), c.added_mass_coefficient = T(s.added_mass_coefficient);
   c.frontal_fraction = T(s.frontal_fraction);
-  c.refinement = {s.refinement.enabled, T(s.refinement.margin), T(s.refinement.top),
-                  T(s.refinement.transition_spacings), T(s.refinement.bunched_fraction)};
+  c.refinement = {s.refinement.enabled,
+                  T(s.refinement.margin),
+                  T(s.refinement.top),
+                  T(s.refinement.transition_spacings),
+                  T(s.refinement.bunched_fraction),
+                  s.refinement.shifting,
+                  T(s.refinement.shift_coefficient)};
   return c;
 }
 
@@ -677,6 +682,9 @@ int main(int argc, char** argv) try {
   s.refinement.transition_spacings = cli.get_number("transition", 4, "refinement: transition zone width / dp");
   s.refinement.bunched_fraction =
       cli.get_number("bunched", 0.3, "refinement: bunched_fraction of the passive fine particles");
+  s.refinement.shifting =
+      cli.get_switch("shift", false, "refinement: particle shifting of the fine particles: on | off");
+  s.refinement.shift_coefficient = cli.get_number("shift-coefficient", 2, "refinement: A of the particle shift");
   o.reference = cli.get("reference", "",
                         "with --refine on: compare with the uniformly fine run in DIR (H within 2 %, tip motion within "
                         "5 %, 2.5 times fewer particle-steps; exit 5 if not)");

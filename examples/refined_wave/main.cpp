@@ -109,6 +109,9 @@ int main(int argc, char** argv) try {
   const bool momentum_account = cli.get_switch("momentum-account", true, "apr: the momentum account: on | off");
   const bool volume_mass =
       cli.get_switch("volume-mass", true, "apr: passive masses from their SPH volume (else nominal): on | off");
+  const bool shift = cli.get_switch("shift", false, "apr: particle shifting of the fine particles: on | off");
+  const double shift_coefficient =
+      cli.get_number("shift-coefficient", 2, "apr: A of the shift -A h |v| dt grad C, (0, 10]");
   if (!cli.finish()) return 0;
   if (method != "split" && method != "apr")
     throw InputError(fmt::format("--method = '{}' is invalid: valid values are split, apr", method));
@@ -159,6 +162,8 @@ int main(int argc, char** argv) try {
   apr_params.conserve_mass = account;
   apr_params.conserve_momentum = momentum_account;
   apr_params.passive_mass_from_volume = volume_mass;
+  apr_params.shifting.enabled = shift;
+  apr_params.shifting.coefficient = shift_coefficient;
 
   // The same flume run with either refinement model.
   auto run = [&](auto model) -> int {

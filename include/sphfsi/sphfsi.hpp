@@ -26,6 +26,7 @@
 #include <sphfsi/eos/tait.hpp>
 #include <sphfsi/fluid/adaptive_refinement.hpp>
 #include <sphfsi/fluid/particle_refinement.hpp>
+#include <sphfsi/fluid/particle_shifting.hpp>
 #include <sphfsi/fluid/thin_structure_guard.hpp>
 #include <sphfsi/fluid/thin_structure_visibility.hpp>
 #include <sphfsi/fluid/wcsph.hpp>

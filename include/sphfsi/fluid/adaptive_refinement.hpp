@@ -60,6 +60,7 @@
 #include <sphfsi/core/parallel.hpp>
 #include <sphfsi/core/types.hpp>
 #include <sphfsi/fluid/particle_refinement.hpp>
+#include <sphfsi/fluid/particle_shifting.hpp>
 
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
@@ -104,8 +105,14 @@ struct AdaptiveRefinementParameters {
   /// Whether a passive particle's mass is its SPH volume times its density (capped at the nominal mass), else the
   /// nominal mass rho0 s^Dim.
   bool passive_mass_from_volume{true};
+  /// Particle shifting (fluid/particle_shifting.hpp) of the active particles before each pass; off by default. With
+  /// shift_refined_only, on the refined levels only (its max_smoothing_length is then set between levels 0 and 1),
+  /// so the base fluid stays that of the uniform scene.
+  ParticleShiftingParameters<T> shifting{};
+  bool shift_refined_only{true};
 
   void validate() const {
+    shifting.validate();
     require_positive("AdaptiveRefinementParameters::base_spacing (m)", base_spacing);
     require_positive("AdaptiveRefinementParameters::transition_width (m)", transition_width);
     require_in_open_range("AdaptiveRefinementParameters::split_offset (eps)", split_offset, T(0), T(0.5));
@@ -150,7 +157,7 @@ class AdaptiveRefinement {
   /// level's particles (their active neighbours at a box edge would lack part of their support).
   AdaptiveRefinement(const Domain<Dim, T>& domain, std::vector<Box> boxes,
                      const AdaptiveRefinementParameters<T>& params)
-      : boxes_(std::move(boxes)), params_(params) {
+      : boxes_(std::move(boxes)), params_(params), shifter_(shifting_parameters(params)) {
     params_.validate();
     RefinementParameters<T> check;  // the box checks are those of the splitting scheme
     check.base_spacing = params_.base_spacing;
@@ -185,6 +192,7 @@ class AdaptiveRefinement {
   T stable_time_step(const System&) const { return std::numeric_limits<T>::infinity(); }
   /// One pass after the step [t, t + dt]; rebuilds the neighbour index if the particle set changed.
   void advance(System& system, T t, T dt) {
+    if (params_.shifting.enabled) shifter_.shift(system, dt);
     last_ = pass(system, -1, t + dt);
     accumulate(last_);
   }
@@ -205,6 +213,8 @@ class AdaptiveRefinement {
   }
 
   const AdaptiveRefinementCounts& last_counts() const noexcept { return last_; }
+  /// What the last particle shift did (AdaptiveRefinementParameters::shifting).
+  const ParticleShiftingCounts& last_shift_counts() const noexcept { return shifter_.last_counts(); }
   const AdaptiveRefinementCounts& total_counts() const noexcept { return total_; }
 
   /// Mass and momentum of the active fluid particles (the fluid the equations integrate).
@@ -221,6 +231,13 @@ class AdaptiveRefinement {
   }
 
  private:
+  static ParticleShiftingParameters<T> shifting_parameters(const AdaptiveRefinementParameters<T>& params) {
+    params.validate();  // first: its messages name the refinement parameters
+    ParticleShiftingParameters<T> s = params.shifting;
+    if (params.shift_refined_only) s.max_smoothing_length = T(0.75) * params.smoothing_ratio * params.base_spacing;
+    return s;
+  }
+
   enum class Status : signed char { active, passive, removed };
 
   // sum_b W(|x_a - x_b|, h) s^Dim over a square lattice of spacing s with h = smoothing_ratio s (1 to the kernel's
@@ -546,6 +563,7 @@ class AdaptiveRefinement {
 
   std::vector<Box> boxes_;
   AdaptiveRefinementParameters<T> params_;
+  ParticleShifting<System> shifter_;
   AdaptiveRefinementCounts last_{}, total_{};
   std::vector<int> level_;             // per slot of the pass: level
   std::vector<std::uint8_t> missing_;  // per slot: passive without an active neighbour of another level

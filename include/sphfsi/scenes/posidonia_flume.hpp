@@ -73,6 +73,8 @@ struct PlantRefinement {
   T top{T(0)};                  ///< box top above the bed, m (0: above the crests, the free surface inside the box)
   T transition_spacings{T(4)};  ///< width of the transition zone around the box / dp, [2, 10]
   T bunched_fraction{T(0.3)};   ///< AdaptiveRefinementParameters::bunched_fraction
+  bool shifting{false};         ///< particle shifting of the fine particles (AdaptiveRefinementParameters::shifting)
+  T shift_coefficient{T(2)};    ///< A of the shift (fluid/particle_shifting.hpp), (0, 10]
 };
 
 /// The Posidonia flume: waves, resolution, plants and blade model (lengths in m).
@@ -193,6 +195,8 @@ struct PosidoniaFlume {
     a.transition_width = refinement.transition_spacings * dp();
     a.smoothing_ratio = flume().smoothing_ratio;
     a.bunched_fraction = refinement.bunched_fraction;
+    a.shifting.enabled = refinement.shifting;
+    a.shifting.coefficient = refinement.shift_coefficient;
     return a;
   }
   /// The real blade as a line of rod nodes (rod, drag), not a continuum of particle rows (scaled, equivalent).
