@@ -126,7 +126,8 @@ scenes::PosidoniaFlume<T> converted(const scenes::PosidoniaFlume<double>& s) {
                   T(s.refinement.transition_spacings),
                   T(s.refinement.bunched_fraction),
                   s.refinement.shifting,
-                  T(s.refinement.shift_coefficient)};
+                  T(s.refinement.shift_coefficient),
+                  s.refinement.shift_passive};
   return c;
 }
 
@@ -685,6 +686,8 @@ int main(int argc, char** argv) try {
   s.refinement.shifting =
       cli.get_switch("shift", false, "refinement: particle shifting of the fine particles: on | off");
   s.refinement.shift_coefficient = cli.get_number("shift-coefficient", 2, "refinement: A of the particle shift");
+  s.refinement.shift_passive =
+      cli.get_switch("shift-passive", true, "refinement: shift the passive fine particles too: on | off");
   o.reference = cli.get("reference", "",
                         "with --refine on: compare with the uniformly fine run in DIR (H within 2 %, tip motion within "
                         "5 %, 2.5 times fewer particle-steps; exit 5 if not)");

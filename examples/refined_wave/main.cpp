@@ -112,6 +112,8 @@ int main(int argc, char** argv) try {
   const bool shift = cli.get_switch("shift", false, "apr: particle shifting of the fine particles: on | off");
   const double shift_coefficient =
       cli.get_number("shift-coefficient", 2, "apr: A of the shift -A h |v| dt grad C, (0, 10]");
+  const bool shift_passive =
+      cli.get_switch("shift-passive", false, "apr: shift the passive fine particles too: on | off");
   if (!cli.finish()) return 0;
   if (method != "split" && method != "apr")
     throw InputError(fmt::format("--method = '{}' is invalid: valid values are split, apr", method));
@@ -164,6 +166,7 @@ int main(int argc, char** argv) try {
   apr_params.passive_mass_from_volume = volume_mass;
   apr_params.shifting.enabled = shift;
   apr_params.shifting.coefficient = shift_coefficient;
+  apr_params.shifting.include_passive = shift_passive;
 
   // The same flume run with either refinement model.
   auto run = [&](auto model) -> int {

@@ -772,33 +772,43 @@ TEST_CASE("adaptive refinement: the mass account conserves the active mass to ro
 
 // Particle shifting inside the refined box (AdaptiveRefinementParameters::shifting with shift_refined_only): one pass
 // on the disordered block moving at 0.5 m/s shifts most active fine particles (those inside the box, not passive)
-// and no coarse one: the base fluid stays that of the unrefined scene.
+// and no coarse one: the base fluid stays that of the unrefined scene; the passive fine particles of the transition
+// zone with include_passive only.
 TEST_CASE("adaptive refinement: particle shifting moves the refined level only", "[refinement][apr][shifting]") {
-  AprBlock block;
-  block.params.shifting.enabled = true;
-  auto& p = block.system.particles();
-  block.disorder();
-  for (auto& v : p.velocity) v = V2(0.5, 0);
-  Apr apr(block.system.domain(), block.boxes, block.params);
-  apr.populate(block.system);
-  block.system.update_neighbors();
-  std::vector<V2> start(p.id_capacity(), V2::Constant(std::nan("")));
-  for (std::size_t i = 0; i < p.size(); ++i) start[p.id[i]] = p.position[i];
-  apr.advance(block.system, 0, 2e-3);  // a shift of up to 0.1 h of 1 m/s particles
-  std::size_t coarse_moved = 0, fine_moved = 0, fine_active = 0;
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    if (!(start[p.id[i]] == start[p.id[i]])) continue;  // created by the pass
-    const bool moved = p.position[i] != start[p.id[i]];
-    if (apr.level_of(p.smoothing_length[i]) == 0) coarse_moved += moved;
-    else if (!p.passive[i]) {
-      ++fine_active;
-      fine_moved += moved;
+  for (const bool include_passive : {false, true}) {
+    AprBlock block;
+    block.params.shifting.enabled = true;
+    block.params.shifting.include_passive = include_passive;
+    auto& p = block.system.particles();
+    block.disorder();
+    for (auto& v : p.velocity) v = V2(0.5, 0);
+    Apr apr(block.system.domain(), block.boxes, block.params);
+    apr.populate(block.system);
+    block.system.update_neighbors();
+    std::vector<V2> start(p.id_capacity(), V2::Constant(std::nan("")));
+    for (std::size_t i = 0; i < p.size(); ++i) start[p.id[i]] = p.position[i];
+    apr.advance(block.system, 0, 2e-3);  // a shift of up to 0.1 h of 1 m/s particles
+    std::size_t coarse_moved = 0, fine_moved = 0, fine_active = 0, passive_moved = 0, fine_passive = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      if (!(start[p.id[i]] == start[p.id[i]])) continue;  // created by the pass
+      const bool moved = p.position[i] != start[p.id[i]];
+      if (apr.level_of(p.smoothing_length[i]) == 0) coarse_moved += moved;
+      else if (!p.passive[i]) {
+        ++fine_active;
+        fine_moved += moved;
+      } else {
+        ++fine_passive;
+        passive_moved += moved;
+      }
     }
+    INFO("include_passive " << include_passive << ": fine active particles " << fine_active << ", shifted "
+                            << fine_moved << "; fine passive " << fine_passive << ", shifted " << passive_moved
+                            << "; largest shift " << apr.last_shift_counts().largest_shift << " h");
+    CHECK(coarse_moved == 0);
+    CHECK(fine_moved > fine_active / 2);
+    if (include_passive) CHECK(passive_moved > fine_passive / 2);
+    else CHECK(passive_moved == 0);
+    CHECK(apr.last_shift_counts().shifted == fine_moved + passive_moved);
+    CHECK(apr.last_shift_counts().largest_shift <= block.params.shifting.max_shift + 1e-12);
   }
-  INFO("fine active particles " << fine_active << ", shifted " << fine_moved << "; largest shift "
-                                << apr.last_shift_counts().largest_shift << " h");
-  CHECK(coarse_moved == 0);
-  CHECK(fine_moved > fine_active / 2);
-  CHECK(apr.last_shift_counts().shifted == fine_moved);
-  CHECK(apr.last_shift_counts().largest_shift <= block.params.shifting.max_shift + 1e-12);
 }

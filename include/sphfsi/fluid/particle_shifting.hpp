@@ -46,6 +46,9 @@ struct ParticleShiftingParameters {
   /// Only fluid particles with a smoothing length at most this are shifted (infinity: all), m.
   T max_smoothing_length{std::numeric_limits<T>::infinity()};
   bool same_resolution_only{true};  ///< grad C from the particles of a's own smoothing length only
+  /// Whether passive fluid particles (AdaptiveRefinement: not integrated, they follow interpolated values) are
+  /// shifted too; they carry no conserved mass or momentum.
+  bool include_passive{false};
 
   void validate() const {
     auto positive_up_to = [](const char* name, T value, T hi) {
@@ -93,7 +96,8 @@ class ParticleShifting {
     if (params_.enabled) shift(system, dt);
   }
 
-  /// Computes every shift on the current positions, then applies them. Passive, wall and solid particles stay.
+  /// Computes every shift on the current positions, then applies them. Wall and solid particles stay; passive ones
+  /// too unless include_passive.
   void shift(System& system, T dt) {
     auto& p = system.particles();
     const auto& kernel = system.kernel();
@@ -105,7 +109,8 @@ class ParticleShifting {
     surface_.assign(n, 0);
     flag_.assign(n, 0);
     auto shifted = [&](std::size_t a) {
-      return p.kind[a] == Kind::fluid && !p.passive[a] && p.smoothing_length[a] <= params_.max_smoothing_length;
+      return p.kind[a] == Kind::fluid && (!p.passive[a] || params_.include_passive) &&
+             p.smoothing_length[a] <= params_.max_smoothing_length;
     };
     auto counted = [&](std::size_t a, std::size_t b, T r) {  // b in a's concentration
       return p.kind[b] != Kind::solid && r < T(Kernel::support) * p.smoothing_length[a] &&

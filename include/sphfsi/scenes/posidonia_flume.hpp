@@ -75,6 +75,7 @@ struct PlantRefinement {
   T bunched_fraction{T(0.3)};   ///< AdaptiveRefinementParameters::bunched_fraction
   bool shifting{false};         ///< particle shifting of the fine particles (AdaptiveRefinementParameters::shifting)
   T shift_coefficient{T(2)};    ///< A of the shift (fluid/particle_shifting.hpp), (0, 10]
+  bool shift_passive{true};     ///< with shifting: the passive fine particles (transition zone) are shifted too
 };
 
 /// The Posidonia flume: waves, resolution, plants and blade model (lengths in m).
@@ -197,6 +198,7 @@ struct PosidoniaFlume {
     a.bunched_fraction = refinement.bunched_fraction;
     a.shifting.enabled = refinement.shifting;
     a.shifting.coefficient = refinement.shift_coefficient;
+    a.shifting.include_passive = refinement.shift_passive;
     return a;
   }
   /// The real blade as a line of rod nodes (rod, drag), not a continuum of particle rows (scaled, equivalent).
