@@ -3,7 +3,6 @@
 usage: /usr/bin/python3 plot.py <surge_front.csv> <martin_moyce1952_surge_front.csv> [comparison.csv]
 Writes surge_front.png next to the simulation CSV.
 """
-import csv
 import os
 import sys
 
@@ -12,12 +11,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-
-def read(path):
-    with open(path) as f:
-        rows = [r for r in csv.reader(line for line in f if not line.startswith("#"))]
-    header, body = rows[0], rows[1:]
-    return {name: [float(r[i]) for r in body] for i, name in enumerate(header)}
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "plotting"))
+from sphfsi_csv import read_columns as read  # noqa: E402
 
 
 sim = read(sys.argv[1])

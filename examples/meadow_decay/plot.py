@@ -3,7 +3,6 @@ of Luhar et al. (2017, case H1), and the tip excursion of three blades.
 
 Usage: /usr/bin/python3 examples/meadow_decay/plot.py OUTPUT_DIR MEASURED_CSV [PNG]
 """
-import csv
 import os
 import sys
 
@@ -12,12 +11,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-
-def read(path):
-    with open(path) as f:
-        rows = [r for r in csv.reader(line for line in f if not line.startswith("#"))]
-    head, body = rows[0], rows[1:]
-    return {name: [float(r[i]) for r in body] for i, name in enumerate(head)}
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "plotting"))
+from sphfsi_csv import read_columns as read  # noqa: E402
 
 
 out, measured_path = sys.argv[1], sys.argv[2]

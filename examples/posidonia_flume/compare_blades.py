@@ -5,7 +5,6 @@ Usage: /usr/bin/python3 examples/posidonia_flume/compare_blades.py PNG [--empty 
 With --empty DIR the heights of every run are compared with DIR/empty/wave_heights.csv (for runs made with
 --runs plants and no --empty-from); otherwise each run's own comparison.csv is used.
 """
-import csv
 import os
 import sys
 
@@ -14,11 +13,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-
-def read(path):
-    with open(path) as f:
-        rows = [r for r in csv.reader(line for line in f if not line.startswith("#"))]
-    return {name: [float(r[i]) for r in rows[1:]] for i, name in enumerate(rows[0])}
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "plotting"))
+from sphfsi_csv import read_columns as read  # noqa: E402
 
 
 args = sys.argv[1:]

@@ -2,7 +2,6 @@
 
 Usage: plot.py OUTPUT_FOLDER [PNG]   (reads comparison.csv and plants/tips.csv; writes OUTPUT_FOLDER/posidonia_flume.png
 or PNG)"""
-import csv
 import math
 import os
 import sys
@@ -12,12 +11,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
-
-def read(path):
-    with open(path) as f:
-        rows = [r for r in csv.reader(line for line in f if not line.startswith("#"))]
-    header, data = rows[0], rows[1:]
-    return {name: [float(r[i]) for r in data] for i, name in enumerate(header)}
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "plotting"))
+from sphfsi_csv import read_columns as read  # noqa: E402
 
 
 out = sys.argv[1]

@@ -3,7 +3,7 @@ coarse runs of examples/posidonia_flume: H at the gauges, the tip's dx(t) and dz
 
 Usage: plot_refined.py PNG LABEL=FOLDER ...   (each FOLDER an --output of posidonia_flume with a plants run;
 reads FOLDER/plants/wave_heights.csv and FOLDER/plants/tips.csv)"""
-import csv
+import os
 import sys
 
 import matplotlib
@@ -11,12 +11,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
-
-def read(path):
-    with open(path) as f:
-        rows = [r for r in csv.reader(line for line in f if not line.startswith("#"))]
-    header, data = rows[0], rows[1:]
-    return {name: [float(r[i]) for r in data] for i, name in enumerate(header)}
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "plotting"))
+from sphfsi_csv import read_columns as read  # noqa: E402
 
 
 png = sys.argv[1]
