@@ -15,6 +15,7 @@
 // --refine on (drag blades, --runs plants): fine fluid (dp / 2) around the plants only, by adaptive particle
 // refinement (scenes::PlantRefinement); --reference DIR compares it with a uniformly fine run in DIR
 // (docs/variable-resolution.md section 4).
+#include <sphfsi/analysis/wave_reflection.hpp>
 #include <sphfsi/analysis/zero_crossing.hpp>
 #include <sphfsi/coupling/coupled_body.hpp>
 #include <sphfsi/coupling/repulsive_force.hpp>
@@ -75,6 +76,10 @@ struct CaseResult {
   std::vector<double> water_dx_amplitude, water_dx_mean;  // the water beside each tip, per plant, m
   std::vector<double> tip_dz_lowest;                      // per plant, over the whole run, m
   std::vector<double> current_mean;  // the Eulerian mean horizontal velocity at each plant's mid-height, m/s
+  // incident and reflected amplitudes at the paddle's frequency from the gauges upstream of the plants, m (NaN: fewer
+  // than two such gauges, or no complete record)
+  double incident_amplitude{std::numeric_limits<double>::quiet_NaN()};
+  double reflected_amplitude{std::numeric_limits<double>::quiet_NaN()};
   std::size_t fluid{0}, wall{0}, solid{0}, steps{0}, solid_sub_steps{0}, fluid_inside_max{0}, crossings{0}, put_back{0};
   double particle_steps{0};  // sum over the steps of the particle count (it changes with refinement)
   double lowest_node{std::numeric_limits<double>::quiet_NaN()};  // rods: lowest free node above the bed, m
@@ -359,6 +364,42 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
     r.height.push_back(H), r.height_std.push_back(s), r.period.push_back(T_);
     heights.write_row({x, H, s, T_, n});
   }
+  // Incident and reflected waves at the paddle's frequency from the gauges upstream of the (first) plant position
+  // (Mansard & Funke 1980; Goda & Suzuki 1976 with two gauges): what the plants, and a refinement box, send back. The
+  // window opens when the wave reflected at the plant position has reached the farthest of these gauges.
+  {
+    const double x_plant = double(scene.first_plant_x);
+    std::vector<double> xs;
+    std::vector<std::vector<double>> records;
+    for (std::size_t i = 0; i < scene.gauges.size(); ++i)
+      if (double(scene.gauges[i]) < x_plant) {
+        xs.push_back(double(scene.gauges[i]));
+        records.emplace_back(gauges.series(i).begin(), gauges.series(i).end());
+      }
+    if (xs.size() >= 2) {
+      const double x_min = *std::min_element(xs.begin(), xs.end());
+      const double from = double(maker.ramp_time()) + (2 * x_plant - x_min) / double(wave.group_velocity);
+      io::CsvWriter csv(dir / "reflection.csv",
+                        {"from", "to", "incident_amplitude", "reflected_amplitude", "K_r", "residual", "gauges"},
+                        fmt::format("incident and reflected amplitudes (m) at omega = {:.4f} rad/s, k = {:.4f} rad/m "
+                                    "from the gauges upstream of x = {:.3f} m (Mansard & Funke 1980)",
+                                    double(wave.angular_frequency), double(wave.wave_number), x_plant));
+      try {
+        const auto sep = analysis::separate_incident_reflected<double>(t, records, xs, double(wave.angular_frequency),
+                                                                       double(wave.wave_number), from, r.reached);
+        r.incident_amplitude = sep.incident_amplitude, r.reflected_amplitude = sep.reflected_amplitude;
+        fmt::print(
+            "reflection ({} gauges upstream of x = {:.2f} m, {:.2f}-{:.2f} s): incident amplitude {:.5f} m, "
+            "reflected {:.5f} m, K_r = {:.4f}\n",
+            xs.size(), x_plant, from, r.reached, sep.incident_amplitude, sep.reflected_amplitude,
+            sep.reflection_coefficient);
+        csv.write_row({from, r.reached, sep.incident_amplitude, sep.reflected_amplitude, sep.reflection_coefficient,
+                       sep.residual, double(xs.size())});
+      } catch (const InputError& e) {
+        fmt::print("reflection: not separated ({})\n", e.what());
+      }
+    }
+  }
   // tip excursion: half the peak-to-peak displacement once the full waves have reached the plant
   for (std::size_t k = 0; k < plant_count; ++k) {
     const double from =
@@ -426,10 +467,12 @@ bool compare_with_reference(const Options& o, const CaseResult& with) {
   double reference_steps = 0;
   for (std::size_t i = 0; i < run_column.size(); ++i)
     if (run_column[i] == 1) reference_steps = steps_column[i];
-  io::CsvWriter out(o.out / "refinement_comparison.csv", {"quantity", "index", "refined", "reference", "error"},
-                    fmt::format("refined run against the uniformly fine run in {}; errors relative (H: to the "
-                                "reference H; tip dx, dz: to the reference tip dx excursion)",
-                                o.reference.string()));
+  io::CsvWriter out(
+      o.out / "refinement_comparison.csv", {"quantity", "index", "refined", "reference", "error"},
+      fmt::format("refined run against the uniformly fine run in {}; errors relative (H: to the "
+                  "reference H; tip dx, dz: to the reference tip dx excursion); quantity 0 H, 1 tip dx, 2 tip dz, 3 "
+                  "particle-steps (error: the saving), 4 incident amplitude, 5 K_r (error: the difference)",
+                  o.reference.string()));
   bool pass = true;
   fmt::print("\nagainst the uniformly fine run ({}):\n", o.reference.string());
   for (std::size_t i = 0; i < H.size(); ++i) {
@@ -449,6 +492,20 @@ bool compare_with_reference(const Options& o, const CaseResult& with) {
         100 * ez);
     out.write_row({1, double(k), with.tip_dx_amplitude[k], dx[k], ex});
     out.write_row({2, double(k), with.tip_dz_amplitude[k], dz[k], ez});
+  }
+  // diagnostic, no criterion: the incident wave and its reflection upstream of the plants (reflection.csv)
+  if (std::filesystem::exists(dir / "reflection.csv") && !std::isnan(with.incident_amplitude)) {
+    const auto reflection = io::read_csv(dir / "reflection.csv");
+    const double a = reflection.column("incident_amplitude").at(0), b = reflection.column("reflected_amplitude").at(0);
+    const double e = with.incident_amplitude / a - 1;
+    fmt::print(
+        "  upstream of the plants: incident amplitude {:.5f} m, fine {:.5f} m: {:+.2f} %; reflected {:.5f} m "
+        "(K_r {:.4f}), fine {:.5f} m (K_r {:.4f}) (no criterion)\n",
+        with.incident_amplitude, a, 100 * e, with.reflected_amplitude,
+        with.reflected_amplitude / with.incident_amplitude, b, b / a);
+    out.write_row({4, 0, with.incident_amplitude, a, e});
+    out.write_row({5, 0, with.reflected_amplitude / with.incident_amplitude, b / a,
+                   with.reflected_amplitude / with.incident_amplitude - b / a});
   }
   const double saving = reference_steps / with.particle_steps;
   pass = pass && saving >= 2.5;

@@ -473,5 +473,5 @@ TEST_CASE("posidonia drag plants in a refined box: the box on the base lattice, 
   CHECK_THROWS_WITH(bad.validate(), Catch::Contains("refinement.top"));
   bad = s;
   bad.refinement.transition_spacings = 1;
-  CHECK_THROWS_WITH(bad.validate(), Catch::Contains("transition_spacings") && Catch::Contains("[2, 10]"));
+  CHECK_THROWS_WITH(bad.validate(), Catch::Contains("transition_spacings") && Catch::Contains("[2, 20]"));
 }

@@ -71,7 +71,7 @@ struct PlantRefinement {
   bool enabled{false};
   T margin{T(0.1)};             ///< box extent beyond the first and the last plant, m
   T top{T(0)};                  ///< box top above the bed, m (0: above the crests, the free surface inside the box)
-  T transition_spacings{T(4)};  ///< width of the transition zone around the box / dp, [2, 10]
+  T transition_spacings{T(4)};  ///< width of the transition zone around the box / dp, [2, 20]
   T bunched_fraction{T(0.3)};   ///< AdaptiveRefinementParameters::bunched_fraction
   bool shifting{false};         ///< particle shifting of the fine particles (AdaptiveRefinementParameters::shifting)
   T shift_coefficient{T(2)};    ///< A of the shift (fluid/particle_shifting.hpp), (0, 10]
@@ -163,7 +163,7 @@ struct PosidoniaFlume {
             "PosidoniaFlume::refinement needs plants with the porous drag blade (BladeModel::drag): the other "
             "couplings would see the fluid of both resolutions");
       require_in_range("PosidoniaFlume::refinement.transition_spacings (transition width / dp)",
-                       refinement.transition_spacings, T(2), T(10));
+                       refinement.transition_spacings, T(2), T(20));
       // the nodes' kernel support (2 h at dp / 2: 2 dp with the flume's h = 2 dp) and the tips' sway stay in the box
       require_in_range("PosidoniaFlume::refinement.margin (m)", refinement.margin, T(6) * dp(),
                        absorber_start - (first_plant_x + T(plants - 1) * spacing));
