@@ -340,7 +340,6 @@ class AdaptiveRefinement {
     auto& p = system.particles();
     const std::size_t n = p.size();
     AdaptiveRefinementCounts counts;
-    const std::size_t children = std::size_t(1) << Dim;
     const bool account = initial_level < 0 && (params_.conserve_mass || params_.conserve_momentum);
     const auto before = account ? active_mass_momentum(system) : std::pair{T(0), Vector::Zero().eval()};
     // 1. Statuses; particles finer than every box within transition_width of them are removed.
@@ -364,42 +363,85 @@ class AdaptiveRefinement {
       p.passive[a] = passive;
     }
     // Passive particles of a transition zone that bunched up (closer than bunched_fraction of their spacing to a
-    // particle of their level that stays: an active one, or a passive one in a lower slot) are removed too.
-    for (std::size_t a = 0; a < n; ++a) {
-      if (p.kind[a] != Kind::fluid || leaving_[a] || !p.passive[a] || level_[a] <= level_inside(p.position[a]))
-        continue;
-      const T close = params_.bunched_fraction * params_.base_spacing / std::pow(T(2), T(level_[a]));
-      bool bunched = false;
+    // particle of their level that stays: an active one, or a passive one in a lower slot) are removed too. In slot
+    // order, since a removal frees the particles above; the neighbours are first screened in parallel against the
+    // removals so far (a superset of the particles that stay), so only the few with a close passive one in a lower
+    // slot are looked at again in order.
+    constexpr unsigned close_active = 1u, close_lower_passive = 2u;  // flags of close_
+    close_.assign(n, 0);
+    auto bunched_candidate = [&](std::size_t a) {
+      return p.kind[a] == Kind::fluid && !leaving_[a] && p.passive[a] && level_[a] > level_inside(p.position[a]);
+    };
+    auto close_distance = [&](std::size_t a) {
+      return params_.bunched_fraction * params_.base_spacing / std::pow(T(2), T(level_[a]));
+    };
+    parallel_for(n, [&](std::size_t a) {
+      if (!bunched_candidate(a)) return;
+      const T close = close_distance(a);
+      unsigned found = 0u;
       system.for_each_neighbor(a, [&](std::size_t b, const Vector&, T r, T) {
-        bunched = bunched || (r < close && p.kind[b] == Kind::fluid && !leaving_[b] && level_[b] == level_[a] &&
-                              (!p.passive[b] || b < a));
+        if (r < close && p.kind[b] == Kind::fluid && !leaving_[b] && level_[b] == level_[a])
+          found |= !p.passive[b] ? close_active : b < a ? close_lower_passive : 0u;
       });
+      close_[a] = static_cast<std::uint8_t>(found);
+    });
+    for (std::size_t a = 0; a < n; ++a) {
+      if (close_[a] == 0) continue;
+      bool bunched = (close_[a] & close_active) != 0;
+      if (!bunched) {  // a close passive one in a lower slot: bunched if it was not removed itself
+        const T close = close_distance(a);
+        system.for_each_neighbor(a, [&](std::size_t b, const Vector&, T r, T) {
+          bunched = bunched || (r < close && p.kind[b] == Kind::fluid && !leaving_[b] && level_[b] == level_[a] &&
+                                p.passive[b] && b < a);
+        });
+      }
       if (!bunched) continue;
       removals_.push_back(a);
       leaving_[a] = 1;
     }
     // 2. Children of the active particles in a finer box's transition zone, where no particle of their level that
-    // stays lies within occupied_fraction of their spacing (the box fills from its transition zone only).
+    // stays lies within occupied_fraction of their spacing (the box fills from its transition zone only). Each
+    // parent's free child places are found in parallel (bit c of free_children_), then created in slot order.
+    const std::size_t children = std::size_t(1) << Dim;
+    auto child_position = [&](std::size_t a, std::size_t c, T spacing) {
+      Vector x = p.position[a];
+      for (int d = 0; d < Dim; ++d)
+        x[d] += ((c >> d) & 1u) ? T(2) * params_.split_offset * spacing : -T(2) * params_.split_offset * spacing;
+      return x;
+    };
+    auto child_spacing = [&](int k) { return T(0.5) * params_.base_spacing / std::pow(T(2), T(k)); };
+    free_children_.assign(n, 0);
+    parallel_for(n, [&](std::size_t a) {
+      if (p.kind[a] != Kind::fluid || leaving_[a]) return;
+      const int k = level_[a];
+      if (initial_level >= 0 ? k != initial_level : (p.passive[a] || k >= level_near(p.position[a]))) return;
+      const T spacing = child_spacing(k);
+      const T gap2 = params_.occupied_fraction * spacing * (params_.occupied_fraction * spacing);
+      Vector place[std::size_t(1) << Dim];
+      unsigned wanted = 0u;
+      for (std::size_t c = 0; c < children; ++c) {
+        place[c] = child_position(a, c, spacing);
+        if (!system.domain().contains(place[c]) || level_near(place[c]) <= k) continue;
+        if (level_inside(place[c]) > k && initial_level < 0) continue;
+        wanted |= 1u << c;
+      }
+      if (wanted == 0u) return;
+      unsigned taken = 0u;
+      system.for_each_neighbor(a, [&](std::size_t b, const Vector&, T, T) {
+        if (p.kind[b] != Kind::fluid || leaving_[b] || level_[b] != k + 1) return;
+        for (std::size_t c = 0; c < children; ++c)
+          if ((p.position[b] - place[c]).squaredNorm() < gap2) taken |= 1u << c;
+      });
+      free_children_[a] = static_cast<std::uint8_t>(wanted & ~taken);
+    });
     created_.clear();
     for (std::size_t a = 0; a < n; ++a) {
-      if (p.kind[a] != Kind::fluid || leaving_[a]) continue;
-      const int k = level_[a];
-      if (initial_level >= 0 ? k != initial_level : (p.passive[a] || k >= level_near(p.position[a]))) continue;
-      const T spacing = T(0.5) * params_.base_spacing / std::pow(T(2), T(k));
-      const T gap = params_.occupied_fraction * spacing;
+      if (free_children_[a] == 0) continue;
+      const T spacing = child_spacing(level_[a]);
       for (std::size_t c = 0; c < children; ++c) {
-        Vector x = p.position[a];
-        for (int d = 0; d < Dim; ++d)
-          x[d] += ((c >> d) & 1u) ? T(2) * params_.split_offset * spacing : -T(2) * params_.split_offset * spacing;
-        if (!system.domain().contains(x) || level_near(x) <= k) continue;
-        const bool in_box = level_inside(x) > k;
-        if (in_box && initial_level < 0) continue;
-        bool taken = false;
-        system.for_each_neighbor(a, [&](std::size_t b, const Vector&, T, T) {
-          taken = taken || (p.kind[b] == Kind::fluid && !leaving_[b] && level_[b] == k + 1 &&
-                            (p.position[b] - x).squaredNorm() < gap * gap);
-        });
-        if (!taken) created_.push_back({a, x, in_box});
+        if (!((free_children_[a] >> c) & 1u)) continue;
+        const Vector x = child_position(a, c, spacing);
+        created_.push_back({a, x, level_inside(x) > level_[a]});
       }
     }
     const auto first_child_id = p.id_capacity();
@@ -438,9 +480,14 @@ class AdaptiveRefinement {
 
   // Sets velocity and density of particle a from the neighbours b with accept(b): the Shepard mean, or with
   // linear_interpolation the linear moving-least-squares fit where its moment matrix is far from singular. Reads the
-  // accepted neighbours only and writes a only. False where no neighbour is accepted.
+  // accepted neighbours only and writes a only. False where no neighbour is accepted. each(b, r) sees every
+  // neighbour in the same traversal (interpolate_passive's number density).
   template <class Accept>
   bool fit(System& system, std::size_t a, Accept&& accept) {
+    return fit(system, a, std::forward<Accept>(accept), [](std::size_t, T) {});
+  }
+  template <class Accept, class Each>
+  bool fit(System& system, std::size_t a, Accept&& accept, Each&& each) {
     using Moment = Eigen::Matrix<T, Dim + 1, Dim + 1>;
     using Column = Eigen::Matrix<T, Dim + 1, 1>;
     using Values = Eigen::Matrix<T, Dim + 1, Dim + 1>;  // columns: density, velocity components
@@ -453,6 +500,7 @@ class AdaptiveRefinement {
     Values rhs = Values::Zero();
     const T scale = T(1) / p.smoothing_length[a];
     system.for_each_neighbor(a, [&](std::size_t b, const Vector& dx, T r, T h) {
+      each(b, r);
       if (!accept(b)) return;
       const T w = p.mass[b] / p.density[b] * kernel.value(r, h);
       Column f;
@@ -499,34 +547,34 @@ class AdaptiveRefinement {
     for (std::size_t a = 0; a < n; ++a)
       if (p.kind[a] == Kind::fluid) level_[a] = level_of_particle(p, a);
     missing_.assign(n, 0);
-    parallel_for(n, [&](std::size_t a) {
-      if (p.kind[a] != Kind::fluid || !p.passive[a]) return;
-      const bool found = fit(system, a, [&](std::size_t b) {
-        return p.kind[b] == Kind::fluid && !p.passive[b] &&
-               (level_[b] != level_[a] || params_.interpolate_from_own_level);
-      });
-      if (!found) missing_[a] = 1;
-    });
-    for (std::uint8_t m : missing_) counts.uninterpolated += m;
     // Passive masses: rho_a / sum_b W_ab over the particles of its level (its SPH volume), at most the nominal
     // mass, so passive particles that bunched up (they follow an interpolated velocity, not their own pressure)
-    // do not weigh more in their active neighbours' sums than the fluid they stand for.
-    if (!params_.passive_mass_from_volume) {
-      for (std::size_t a = 0; a < n; ++a)
-        if (p.kind[a] == Kind::fluid && p.passive[a]) p.mass[a] = nominal_mass(level_[a], rho0);
-      return;
-    }
+    // do not weigh more in their active neighbours' sums than the fluid they stand for. The number density is
+    // summed in the fit's traversal.
+    const bool from_volume = params_.passive_mass_from_volume;
     parallel_for(n, [&](std::size_t a) {
       if (p.kind[a] != Kind::fluid || !p.passive[a]) return;
       const T h = p.smoothing_length[a];
       T number_density = kernel.value(T(0), h);
-      system.for_each_neighbor(a, [&](std::size_t b, const Vector&, T r, T) {
-        if (p.kind[b] == Kind::fluid && level_[b] == level_[a]) number_density += kernel.value(r, h);
-      });
+      const bool found = fit(
+          system, a,
+          [&](std::size_t b) {
+            return p.kind[b] == Kind::fluid && !p.passive[b] &&
+                   (level_[b] != level_[a] || params_.interpolate_from_own_level);
+          },
+          [&](std::size_t b, T r) {
+            if (from_volume && p.kind[b] == Kind::fluid && level_[b] == level_[a]) number_density += kernel.value(r, h);
+          });
+      if (!found) missing_[a] = 1;
+      if (!from_volume) {
+        p.mass[a] = nominal_mass(level_[a], rho0);
+        return;
+      }
       const T spacing = params_.base_spacing / std::pow(T(2), T(level_[a]));
       p.mass[a] = nominal_mass(level_[a], rho0) *
                   std::min(T(1), lattice_number_density_ / (number_density * std::pow(spacing, T(Dim))));
     });
+    for (std::uint8_t m : missing_) counts.uninterpolated += m;
   }
 
   void check_walls(const System& system) const {
@@ -565,13 +613,15 @@ class AdaptiveRefinement {
   AdaptiveRefinementParameters<T> params_;
   ParticleShifting<System> shifter_;
   AdaptiveRefinementCounts last_{}, total_{};
-  std::vector<int> level_;             // per slot of the pass: level
-  std::vector<std::uint8_t> missing_;  // per slot: passive without an active neighbour of another level
-  std::vector<std::uint8_t> leaving_;  // per slot of the pass: 1 if removed in it
-  T lattice_number_density_{1};        // lattice_number_density() of the kernel (populate)
-  std::vector<std::size_t> removals_;  // slots to remove
-  std::vector<Child> created_;         // children to create
-  std::vector<std::size_t> edge_;      // slots of the active particles near a box edge (the accounts)
+  std::vector<int> level_;                   // per slot of the pass: level
+  std::vector<std::uint8_t> missing_;        // per slot: passive without an active neighbour of another level
+  std::vector<std::uint8_t> leaving_;        // per slot of the pass: 1 if removed in it
+  T lattice_number_density_{1};              // lattice_number_density() of the kernel (populate)
+  std::vector<std::size_t> removals_;        // slots to remove
+  std::vector<Child> created_;               // children to create
+  std::vector<std::uint8_t> close_;          // per slot of the pass: flags of the bunched test
+  std::vector<std::uint8_t> free_children_;  // per slot of the pass: bit c set if child c is created
+  std::vector<std::size_t> edge_;            // slots of the active particles near a box edge (the accounts)
 };
 
 }  // namespace sphfsi

@@ -170,7 +170,8 @@ class WcsphFluid {
   /// Each neighbour pair is evaluated once (ParticleSystem::for_each_neighbor_once) and applied to both particles:
   /// W, grad W and the pair terms are symmetric (grad_b W = -grad_a W), so the pair's contributions to a and b
   /// differ only by the partner's mass and sign. Threads take contiguous slot ranges; what a pair adds to a slot
-  /// beyond its range goes to that range's spill buffer, added after the parallel loop.
+  /// beyond its range goes to that range's spill buffer, added after the parallel loop. A pair of two passive fluid
+  /// particles (fluid/adaptive_refinement.hpp) adds only to their signal speeds: their rates are zeroed anyway.
   void compute_rates(System& system) {
     auto& p = system.particles();
     const std::size_t n = p.size();
@@ -425,6 +426,7 @@ class WcsphFluid {
     const T* volume = volume_.data();
 
     const bool fluid_a = ka == Kind::fluid;
+    const bool passive_a = fluid_a && p.passive[a];
     const bool same_resolution = params_.same_resolution_pairs;
     const T h_a = p.smoothing_length[a];
     const Vector xa = x[a], va = v[a];
@@ -441,6 +443,12 @@ class WcsphFluid {
         if (occluded_ && (visibility_.near(a) || visibility_.near(b)) && visibility_.blocks(a, b, xa, x[b])) return;
       }
       const Vector vab = va - v[b];
+      if (passive_a && fluid_b && p.passive[b]) {  // both carried (their rates are zeroed): only the time step's
+        const T mu = h * vab.dot(dx) * (T(1) / (r * r + T(0.01) * h * h));  // signal speed, as below
+        mu_max = std::max(mu_max, std::abs(mu));
+        partner.raise_signal_speed(b, std::abs(mu));
+        return;
+      }
       if (!dynamic_walls && !(fluid_a && fluid_b)) {  // repulsive wall: pushes the fluid particle only
         if (fluid_a)
           acc += repulsive_force<Dim, T>(dx, vab, p.normal[b], h, c0, xa[up] - water_level, params_.repulsive);
