@@ -14,13 +14,14 @@
 // snapshots; DIR/comparison.csv (H at each gauge, both runs) and DIR/posidonia_flume.png. See docs/posidonia.md.
 // --refine on (drag blades, --runs plants): fine fluid (dp / 2) around the plants only, by adaptive particle
 // refinement (scenes::PlantRefinement); --reference DIR compares it with a uniformly fine run in DIR
-// (docs/variable-resolution.md section 4).
+// (docs/variable-resolution.md section 4); --local-steps on steps the coarse fluid at twice the fine step.
 #include <sphfsi/analysis/wave_reflection.hpp>
 #include <sphfsi/analysis/zero_crossing.hpp>
 #include <sphfsi/coupling/coupled_body.hpp>
 #include <sphfsi/coupling/repulsive_force.hpp>
 #include <sphfsi/eos/tait.hpp>
 #include <sphfsi/fluid/adaptive_refinement.hpp>
+#include <sphfsi/integrators/local_time_stepping.hpp>
 #include <sphfsi/integrators/simulation.hpp>
 #include <sphfsi/integrators/symplectic.hpp>
 #include <sphfsi/io/command_line.hpp>
@@ -64,6 +65,8 @@ struct Options {
   bool visibility{false};
   // Rod blades: a fluid particle that steps through a blade is put back on its face (fluid/thin_structure_guard.hpp).
   bool guard{true};
+  // --refine on: the coarse fluid steps at twice the fine step (integrators/local_time_stepping.hpp).
+  bool local_steps{false};
   std::filesystem::path out;
   std::filesystem::path empty_from;  // reuse DIR/empty/wave_heights.csv of an earlier run instead of the empty run
   std::filesystem::path reference;   // the uniformly fine run to compare a refined run with (DIR/plants)
@@ -81,7 +84,7 @@ struct CaseResult {
   double incident_amplitude{std::numeric_limits<double>::quiet_NaN()};
   double reflected_amplitude{std::numeric_limits<double>::quiet_NaN()};
   std::size_t fluid{0}, wall{0}, solid{0}, steps{0}, solid_sub_steps{0}, fluid_inside_max{0}, crossings{0}, put_back{0};
-  double particle_steps{0};  // sum over the steps of the particle count (it changes with refinement)
+  double particle_steps{0};  // Simulation::particle_steps(): particles advanced, summed over the (sub-)steps
   double lowest_node{std::numeric_limits<double>::quiet_NaN()};  // rods: lowest free node above the bed, m
   double wall_seconds{0}, end_time{0}, reached{0}, max_stretch{1};
   std::string failure;
@@ -140,11 +143,13 @@ scenes::PosidoniaFlume<T> converted(const scenes::PosidoniaFlume<double>& s) {
 /// faces, or porous drag rods.
 enum class Plants { none, continuum, rods, drag_rods };
 
-/// Refined: fine fluid around the plants (scene.refinement; the drag blades only), one more model.
-template <class T, Plants Kind, bool Refined = false>
+/// Refined: fine fluid around the plants (scene.refinement; the drag blades only), one more model; Local: with local
+/// time stepping (the coarse fluid at twice the fine step).
+template <class T, Plants Kind, bool Refined = false, bool Local = false>
 CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
   constexpr bool WithPlants = Kind != Plants::none, Drag = Kind == Plants::drag_rods;
   static_assert(!Refined || Drag, "refinement: the porous drag blades only");
+  static_assert(!Local || Refined, "local time stepping: the refined flume only");
   constexpr bool Rods = Kind == Plants::rods || Drag;  // a rod per plant (RodBlades)
   using System = ParticleSystem<2, T, WendlandC2<2>, Tait<T>>;
   using Solid = TotalLagrangianSolid<System>;
@@ -153,7 +158,9 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
                          std::conditional_t<Rods, scenes::RodBlades<System>, CoupledBody<RepulsiveForce<T>, Solid>>>;
   using Adaptive = AdaptiveRefinement<System>;
   using Solver = std::conditional_t<
-      Refined, Simulation<System, SymplecticVerlet, waves::DampingZone<T>, Plant, Adaptive>,
+      Refined,
+      Simulation<System, std::conditional_t<Local, LocalSymplecticVerlet, SymplecticVerlet>, waves::DampingZone<T>,
+                 Plant, Adaptive>,
       std::conditional_t<WithPlants, Simulation<System, SymplecticVerlet, waves::DampingZone<T>, Plant>,
                          Simulation<System, SymplecticVerlet, waves::DampingZone<T>>>>;
   scenes::PosidoniaFlume<T> scene = converted<T>(o.scene);
@@ -270,7 +277,7 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
   try {
     sim.run(T(r.end_time), [&](Solver& sm) {
       progress(sm);
-      r.particle_steps += double(sm.system().size());
+      r.particle_steps = sm.particle_steps();
       if constexpr (Rods && !Drag) {
         // Every step (porous blades: the water passes): between samples a particle beside the tip could go round it.
         crossings.update(sm.system(), sm.template model<1>());
@@ -571,7 +578,8 @@ int run(const Options& o) {
 
   CaseResult with, without;
   if (o.run_plants)
-    with = scene.refinement.enabled                  ? run_case<T, Plants::drag_rods, true>(o, o.out / "plants")
+    with = scene.refinement.enabled && o.local_steps ? run_case<T, Plants::drag_rods, true, true>(o, o.out / "plants")
+           : scene.refinement.enabled                ? run_case<T, Plants::drag_rods, true>(o, o.out / "plants")
            : scene.blade == scenes::BladeModel::drag ? run_case<T, Plants::drag_rods>(o, o.out / "plants")
            : scene.blade == scenes::BladeModel::rod  ? run_case<T, Plants::rods>(o, o.out / "plants")
                                                      : run_case<T, Plants::continuum>(o, o.out / "plants");
@@ -745,6 +753,8 @@ int main(int argc, char** argv) try {
   s.refinement.shift_coefficient = cli.get_number("shift-coefficient", 2, "refinement: A of the particle shift");
   s.refinement.shift_passive =
       cli.get_switch("shift-passive", true, "refinement: shift the passive fine particles too: on | off");
+  o.local_steps = cli.get_switch("local-steps", false,
+                                 "refinement: local time stepping, the coarse fluid at twice the fine step: on | off");
   o.reference = cli.get("reference", "",
                         "with --refine on: compare with the uniformly fine run in DIR (H within 2 %, tip motion within "
                         "5 %, 2.5 times fewer particle-steps; exit 5 if not)");
@@ -766,6 +776,8 @@ int main(int argc, char** argv) try {
     throw InputError(
         "--refine on: use --runs plants (the empty flume has no plants to refine around; compare with a "
         "uniformly fine run through --reference)");
+  if (o.local_steps && !s.refinement.enabled)
+    throw InputError("--local-steps on: only with --refine on (one resolution has one time level)");
   s.validate();
   if (precision == "float") return run<float>(o);
   if (precision == "double") return run<double>(o);

@@ -31,6 +31,7 @@
 #include <sphfsi/fluid/thin_structure_visibility.hpp>
 #include <sphfsi/fluid/wcsph.hpp>
 #include <sphfsi/integrators/concepts.hpp>
+#include <sphfsi/integrators/local_time_stepping.hpp>
 #include <sphfsi/integrators/predictor_corrector.hpp>
 #include <sphfsi/integrators/simulation.hpp>
 #include <sphfsi/integrators/symplectic.hpp>

@@ -49,6 +49,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <vector>
 
@@ -172,18 +173,32 @@ class WcsphFluid {
   /// differ only by the partner's mass and sign. Threads take contiguous slot ranges; what a pair adds to a slot
   /// beyond its range goes to that range's spill buffer, added after the parallel loop. A pair of two passive fluid
   /// particles (fluid/adaptive_refinement.hpp) adds only to their signal speeds: their rates are zeroed anyway.
-  void compute_rates(System& system) {
+  ///
+  /// `frozen` (one flag per slot, or null): local time stepping (integrators/local_time_stepping.hpp) evaluates only
+  /// the particles that take a step now; a frozen slot keeps the rates it has, and its pairs are skipped. It needs
+  /// FluidParameters::same_resolution_pairs with the frozen particles one resolution (no pair joins a frozen
+  /// particle to one that is not); the signal speed of a frozen slot is left at zero.
+  void compute_rates(System& system, const std::vector<std::uint8_t>* frozen = nullptr) {
     auto& p = system.particles();
     const std::size_t n = p.size();
+    if (frozen && frozen->size() != n)
+      throw InputError(fmt::format(
+          "WcsphFluid::compute_rates: frozen has {} flags for {} particles (valid: one per slot)", frozen->size(), n));
+    if (frozen && !params_.same_resolution_pairs)
+      throw InputError(
+          "WcsphFluid::compute_rates: frozen particles need FluidParameters::same_resolution_pairs = true (valid: the "
+          "resolutions interact only through passive particles, so no pair joins a frozen particle to a stepping one)");
+    frozen_ = frozen ? frozen->data() : nullptr;
     signal_speed_.assign(n, T(0));
     pressure_term_.resize(n);
     volume_.resize(n);
     parallel_for(n, [&](std::size_t a) {
+      pressure_term_[a] = p.pressure[a] / (p.density[a] * p.density[a]);  // p / rho^2, Pa m^6/kg^2
+      volume_[a] = p.mass[a] / p.density[a];                              // m^3 (m^2 in 2D)
+      if (frozen_ && frozen_[a]) return;
       p.acceleration[a] = Vector::Zero();
       p.density_rate[a] = T(0);
       p.xsph_velocity[a] = Vector::Zero();
-      pressure_term_[a] = p.pressure[a] / (p.density[a] * p.density[a]);  // p / rho^2, Pa m^6/kg^2
-      volume_[a] = p.mass[a] / p.density[a];                              // m^3 (m^2 in 2D)
     });
     if (params_.gradient_correction != GradientCorrection::none) update_gradient_correction(system);
     occluded_ = guarded_ = false;
@@ -212,7 +227,7 @@ class WcsphFluid {
     }
     const Vector g = params_.gravity;
     parallel_for(n, [&](std::size_t a) {
-      if (p.kind[a] != Kind::fluid) return;
+      if (p.kind[a] != Kind::fluid || (frozen_ && frozen_[a])) return;
       if (p.passive[a]) {  // carried with the velocity its model interpolates; it only serves as a neighbour
         p.acceleration[a] = Vector::Zero();
         p.density_rate[a] = T(0);
@@ -221,17 +236,23 @@ class WcsphFluid {
         p.acceleration[a] += g;
       }
     });
+    frozen_ = nullptr;
   }
 
   /// Stable time step of the last evaluated rates (Monaghan & Kos 1999; SPHysics): min of
   ///   force      sqrt(h / |a|),   acoustic/viscous   h / (c + max_b |mu_ab|),   laminar   h^2 / (8 nu),
   /// without the CFL factor (the integrator applies it).
   T stable_time_step(const System& system) const {
+    return stable_time_step(system, [](std::size_t) { return true; });
+  }
+  /// The same over the fluid particles a for which selected(a) holds (a time level of local time stepping).
+  template <class Selected>
+  T stable_time_step(const System& system, Selected&& selected) const {
     const auto& p = system.particles();
     const T inf = std::numeric_limits<T>::max();
     const T nu = params_.kinematic_viscosity;
     return parallel_min(p.size(), inf, [&](std::size_t a) {
-      if (p.kind[a] != Kind::fluid) return inf;
+      if (p.kind[a] != Kind::fluid || !selected(a)) return inf;
       const T h = p.smoothing_length[a];
       const T f = p.acceleration[a].norm();
       T dt = f > T(0) ? std::sqrt(h / f) : inf;
@@ -401,7 +422,8 @@ class WcsphFluid {
   void accumulate_particle(System& system, std::size_t a, const Sink& partner) {
     auto& p = system.particles();
     const Kind ka = p.kind[a];
-    if (ka == Kind::solid) return;  // solids: fluid-solid pairs belong to the coupling policies
+    if (ka == Kind::solid) return;      // solids: fluid-solid pairs belong to the coupling policies
+    if (frozen_ && frozen_[a]) return;  // keeps its rates (local time stepping): its pairs are all frozen too
     const auto& kernel = system.kernel();
     const T rho0 = system.eos().reference_density();
     const T c0 = system.eos().reference_sound_speed();
@@ -527,6 +549,7 @@ class WcsphFluid {
   ThinStructureGuard<T> guard_;            // keeps the fluid on its face of them
   bool occluded_{false};                   // this evaluation applies the visibility criterion
   bool guarded_{false};                    // this evaluation prepared the thin-structure guard
+  const std::uint8_t* frozen_{nullptr};    // during compute_rates: slots that keep their rates (or null)
 };
 
 }  // namespace sphfsi

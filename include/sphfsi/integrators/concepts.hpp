@@ -6,6 +6,9 @@
 // (evaluate_rates, move_walls, advance_models). It never touches solid particles: solid models advance
 // themselves (with their own, possibly smaller, time step) in advance_models.
 //
+// With local time stepping the step is made of sub-steps: a model's advance is called once per sub-step of the
+// finest level, and its compute_rates at each evaluation.
+//
 // ParticleModel: physics that plugs into a Simulation beside the fluid (solid models, couplings, forcing):
 //   void compute_rates(System&, T time);      // adds its forces after the fluid rates are computed
 //   T stable_time_step(const System&) const;  // limit on the fluid step (infinity if it sub-cycles)
@@ -16,6 +19,14 @@
 #include <type_traits>
 
 namespace sphfsi {
+
+/// LocalTimeStepping: an integrator that advances the finest particles in two half steps and the coarser ones in one
+/// (integrators/local_time_stepping.hpp) declares `static constexpr bool local_time_stepping = true;`; Simulation then
+/// sizes its step from each time level's own stability limit and counts particle-steps per level.
+template <class I>
+concept LocalTimeStepping = requires {
+  requires I::local_time_stepping;
+};
 
 template <class M, class System>
 concept ParticleModel = requires(M& m, const M& cm, System& s, const System& cs, typename System::scalar_type t) {

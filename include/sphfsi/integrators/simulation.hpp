@@ -1,7 +1,9 @@
 // sphfsi: the time loop. A Simulation advances a ParticleSystem with a fluid model, walls (fixed or moving
 // with a prescribed motion), any number of extra ParticleModels (solids, couplings) and a TimeIntegrator.
 // The time step varies with the acoustic CFL, force and viscous conditions (WcsphFluid::stable_time_step)
-// unless a fixed step is given; a fixed step above the stability limit is rejected.
+// unless a fixed step is given; a fixed step above the stability limit is rejected. With a LocalTimeStepping
+// integrator (integrators/local_time_stepping.hpp) the step is a macro step: the finest particles take it in two
+// halves, the coarser ones in one, and each time level's own stability limit sizes it.
 #pragma once
 
 #include <sphfsi/core/error.hpp>
@@ -11,6 +13,7 @@
 #include <sphfsi/integrators/concepts.hpp>
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <functional>
 #include <limits>
@@ -85,7 +88,13 @@ class Simulation {
     return std::get<I>(models_);
   }
   static constexpr std::size_t model_count = sizeof...(Models);
+  /// Whether the integrator steps the time levels at their own rates (LocalTimeStepping).
+  static constexpr bool local_time_stepping = LocalTimeStepping<Integrator>;
   T time() const noexcept { return time_; }
+  /// Sum over the steps of the particles each step advanced: every particle once per step; with local time stepping
+  /// the finest level's particles (and solids) twice per macro step, the coarser ones once. The cost measure of
+  /// docs/variable-resolution.md.
+  double particle_steps() const noexcept { return particle_steps_; }
   std::size_t step_count() const noexcept { return steps_; }
   T last_time_step() const noexcept { return dt_; }
 
@@ -123,6 +132,13 @@ class Simulation {
   T step() {
     if (!initialised_) initialise();
     const T dt = next_time_step();
+    const auto n = double(system_.particles().size());
+    if constexpr (local_time_stepping) {
+      update_time_levels();
+      particle_steps_ += 2.0 * n - double(coarse_count_);
+    } else {
+      particle_steps_ += n;
+    }
     Integrator{}.step(*this, dt);
     fluid_.keep_fluid_beside_structures(system_);
     time_ += dt;
@@ -179,43 +195,117 @@ class Simulation {
     dt_ = last_dt;
     reference_position_ = std::move(wall_reference_positions);
     initialised_ = rates_evaluated;
+    level_steps_known_ = false;  // local time stepping: the levels' limits are taken from the saved rates
   }
 
   // ---- hooks used by the integrators ----
 
   /// Neighbours, pressure, fluid and wall rates, then each model's rates, at time t.
-  void evaluate_rates(T t) {
+  ///
+  /// Local time stepping: with freeze_coarse, the coarse time level (time_levels(), recomputed here after the
+  /// neighbour search re-sorted the particles) keeps the rates of its last evaluation, models' contributions included,
+  /// and only the finest level is evaluated. Each evaluation records the stability limit of the levels it evaluated.
+  void evaluate_rates(T t, bool freeze_coarse = false) {
     if (!edges_collected_) collect_structure_edges();
     system_.update_neighbors(t);
     system_.update_pressure();
+    auto& p = system_.particles();
     if (const T p_min = fluid_.parameters().minimum_pressure; p_min > -std::numeric_limits<T>::infinity()) {
-      auto& p = system_.particles();
       parallel_for(p.size(), [&](std::size_t i) {
         if (p.kind[i] == Kind::fluid) p.pressure[i] = std::max(p.pressure[i], p_min);
       });
     }
-    fluid_.compute_rates(system_);
-    std::apply([&](auto&... m) { (m.compute_rates(system_, t), ...); }, models_);
+    if constexpr (local_time_stepping) {
+      update_time_levels();
+      freeze_coarse = freeze_coarse && coarse_count_ > 0;
+      fluid_.compute_rates(system_, freeze_coarse ? &coarse_ : nullptr);
+      if (freeze_coarse) {  // the models add to the fluid's rates: the frozen ones are kept as they were
+        frozen_acceleration_.resize(p.size());
+        frozen_xsph_.resize(p.size());
+        frozen_density_rate_.resize(p.size());
+        parallel_for(p.size(), [&](std::size_t i) {
+          if (!coarse_[i]) return;
+          frozen_acceleration_[i] = p.acceleration[i];
+          frozen_xsph_[i] = p.xsph_velocity[i];
+          frozen_density_rate_[i] = p.density_rate[i];
+        });
+      }
+      std::apply([&](auto&... m) { (m.compute_rates(system_, t), ...); }, models_);
+      if (freeze_coarse) {
+        parallel_for(p.size(), [&](std::size_t i) {
+          if (!coarse_[i]) return;
+          p.acceleration[i] = frozen_acceleration_[i];
+          p.xsph_velocity[i] = frozen_xsph_[i];
+          p.density_rate[i] = frozen_density_rate_[i];
+        });
+      }
+      record_level_steps(!freeze_coarse);
+    } else {
+      fluid_.compute_rates(system_);
+      std::apply([&](auto&... m) { (m.compute_rates(system_, t), ...); }, models_);
+    }
   }
 
+  /// Local time stepping: marks the coarse time level, one flag per slot (1: a fluid or wall particle whose smoothing
+  /// length exceeds 1.5 times the smallest one of the fluid and walls; solids step with the finest level), and
+  /// returns the flags. Call it again after anything that re-sorted, added or removed particles. The coarse level
+  /// interacts with the finest one through the refinement's passive particles only, so it needs
+  /// FluidParameters::same_resolution_pairs.
+  const std::vector<std::uint8_t>& update_time_levels() {
+    const auto& p = system_.particles();
+    const std::size_t n = p.size();
+    T h_min = std::numeric_limits<T>::max();
+    for (std::size_t i = 0; i < n; ++i)
+      if (p.kind[i] != Kind::solid) h_min = std::min(h_min, p.smoothing_length[i]);
+    coarse_.assign(n, 0);
+    coarse_count_ = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (p.kind[i] == Kind::solid || !(p.smoothing_length[i] > T(1.5) * h_min)) continue;
+      coarse_[i] = 1;
+      ++coarse_count_;
+    }
+    if (coarse_count_ > 0 && !fluid_.parameters().same_resolution_pairs)
+      throw InputError(
+          fmt::format("local time stepping: {} particles have a smoothing length above 1.5 x the smallest ({:.4g} m) "
+                      "and FluidParameters::same_resolution_pairs is false: valid only with same_resolution_pairs = "
+                      "true (the resolutions meet through passive particles, fluid/adaptive_refinement.hpp), or one "
+                      "smoothing length",
+                      coarse_count_, h_min));
+    return coarse_;
+  }
+  /// The flags of the last update_time_levels() (or evaluation).
+  const std::vector<std::uint8_t>& time_levels() const noexcept { return coarse_; }
+  /// Particles in the coarse time level at the last update_time_levels().
+  std::size_t coarse_particle_count() const noexcept { return coarse_count_; }
+
   /// Places moving wall particles at their prescribed position and velocity at time t.
-  void move_walls(T t) {
+  void move_walls(T t) { move_walls(t, t); }
+  /// The same, local time stepping: the finest level's walls at t_fine, the coarse level's (time_levels()) at
+  /// t_coarse.
+  void move_walls(T t_fine, T t_coarse) {
     if (motions_.empty() && kinematics_.empty()) return;
     auto& p = system_.particles();
+    const bool two_times = t_fine != t_coarse;
+    if (two_times && coarse_.size() != p.size())
+      throw InputError("Simulation::move_walls(t_fine, t_coarse): call update_time_levels() first");
+    auto time_of = [&](std::size_t i) { return two_times && coarse_[i] ? t_coarse : t_fine; };
     for (const auto& [body, kinematics] : kinematics_) {
       for (std::size_t i = 0; i < p.size(); ++i) {
         if (p.kind[i] != Kind::wall || p.body[i] != body) continue;
-        const auto [x, v] = kinematics.state(reference_position_[p.id[i]], t);
+        const auto [x, v] = kinematics.state(reference_position_[p.id[i]], time_of(i));
         p.position[i] = x;
         p.velocity[i] = v;
       }
     }
     for (const auto& [body, motion] : motions_) {
-      const Vector d = motion.displacement(t), v = motion.velocity(t);
+      const Vector d_fine = motion.displacement(t_fine), v_fine = motion.velocity(t_fine);
+      const Vector d_coarse = two_times ? motion.displacement(t_coarse) : d_fine;
+      const Vector v_coarse = two_times ? motion.velocity(t_coarse) : v_fine;
       for (std::size_t i = 0; i < p.size(); ++i) {
         if (p.kind[i] != Kind::wall || p.body[i] != body) continue;
-        p.position[i] = reference_position_[p.id[i]] + d;
-        p.velocity[i] = v;
+        const bool coarse = two_times && coarse_[i];
+        p.position[i] = reference_position_[p.id[i]] + (coarse ? d_coarse : d_fine);
+        p.velocity[i] = coarse ? v_coarse : v_fine;
       }
     }
   }
@@ -231,11 +321,24 @@ class Simulation {
     return rho;
   }
 
-  /// The step the next call to step() will take.
+  /// The step the next call to step() will take. Local time stepping: the macro step, at most twice the finest
+  /// level's limit (models' limits included: they step with it) and the coarse level's limit.
   T next_time_step() {
     if (!initialised_) initialise();
-    T stable = fluid_.stable_time_step(system_);
-    std::apply([&](const auto&... m) { ((stable = std::min(stable, m.stable_time_step(system_))), ...); }, models_);
+    T stable;
+    T sub_steps = T(1);  // sub-steps of the finest level in one step
+    if constexpr (local_time_stepping) {
+      if (!level_steps_known_) {
+        update_time_levels();
+        record_level_steps(true);
+      }
+      sub_steps = T(2);
+      stable = std::min(sub_steps * fine_stable_, coarse_stable_);
+    } else {
+      stable = fluid_.stable_time_step(system_);
+    }
+    std::apply([&](const auto&... m) { ((stable = std::min(stable, sub_steps * m.stable_time_step(system_))), ...); },
+               models_);
     T dt;
     if (time_step_.fixed_dt > T(0)) {
       dt = time_step_.fixed_dt;
@@ -268,6 +371,14 @@ class Simulation {
   template <class Model>
   static void append_structure_edges(const Model& model, std::vector<StructureEdge>& edges) {
     if constexpr (requires { model.structure_edges(edges); }) model.structure_edges(edges);
+  }
+
+  /// Local time stepping: the stability limits of the levels just evaluated (the coarse one only when it was).
+  void record_level_steps(bool coarse_evaluated) {
+    fine_stable_ = fluid_.stable_time_step(system_, [&](std::size_t a) { return !coarse_[a]; });
+    if (coarse_evaluated)
+      coarse_stable_ = fluid_.stable_time_step(system_, [&](std::size_t a) { return coarse_[a] != 0; });
+    level_steps_known_ = true;
   }
 
   void record_reference_positions() {
@@ -347,6 +458,15 @@ class Simulation {
   bool mach_warned_{false};
   bool edges_collected_{false};
   T expected_speed_{0};  // m/s, 0: estimate sqrt(g D)
+  double particle_steps_{0};
+  // Local time stepping: the coarse level's flags per slot, its size, the levels' last stability limits (without
+  // the CFL factor) and the coarse rates kept across a frozen evaluation.
+  std::vector<std::uint8_t> coarse_;
+  std::size_t coarse_count_{0};
+  T fine_stable_{std::numeric_limits<T>::max()}, coarse_stable_{std::numeric_limits<T>::max()};
+  bool level_steps_known_{false};
+  std::vector<Vector> frozen_acceleration_, frozen_xsph_;
+  std::vector<T> frozen_density_rate_;
   std::function<void(const std::string&)> warn_ = [](const std::string& message) {
     std::fprintf(stderr, "warning: %s\n", message.c_str());
   };

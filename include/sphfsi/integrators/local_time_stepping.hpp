@@ -1,0 +1,126 @@
+// sphfsi: local time stepping for overlapping resolutions: the symplectic position-Verlet scheme of
+// integrators/symplectic.hpp with two time levels. The finest particles (and the solids' models) advance in two
+// sub-steps of dt / 2, the coarser fluid and wall particles in one step of dt, so that a particle is stepped at the
+// rate its own resolution needs (the acoustic limit h / c scales with h). Multi-rate integration of this kind is
+// the local (adaptive) time stepping of Lowe, Wang & Zhu 2019 and the multiple time stepping of Zhang, Rezavand &
+// Hu 2021 (J. Comput. Phys. 429:110028) for a fine solid in a coarse fluid; here it is applied to the resolutions of
+// adaptive particle refinement (fluid/adaptive_refinement.hpp), which interact only through passive particles
+// (FluidParameters::same_resolution_pairs), so that no SPH pair joins the two time levels.
+//
+// One macro step [t, t + dt], f the finest level, c the coarse level (Simulation::time_levels()):
+//   sub-step 1:  f drifts dt/4, c drifts dt/2:     x^{n+1/2}_c = x^n_c + dt/2 v^n_c,  rho likewise
+//                one evaluation of both levels:    f at t + dt/4, c at its midpoint t + dt/2
+//                f: kick dt/2 and drift dt/4 to t + dt/2 (as SymplecticVerlet with dt/2)
+//                c: v_c = v^n_c + dt/2 F^{n+1/2}_c, its velocity at t + dt/2 (position and density are
+//                   already there), so that the models and the refinement pass see both levels at t + dt/2
+//                the models advance [t, t + dt/2] (the refinement pass: passive particles of both levels fitted)
+//   sub-step 2:  f as SymplecticVerlet with dt/2; the evaluation at t + 3dt/4 skips c (it keeps F^{n+1/2}_c)
+//                c: v^{n+1}_c = v_c + dt/2 F^{n+1/2}_c,  x^{n+1}_c = x^{n+1/2}_c + dt/2 v^{n+1}_c,
+//                   rho^{n+1}_c = rho^n_c (2 - e) / (2 + e),  e = -dt D^{n+1/2}_c / rho^{n+1/2}_c
+//                the models advance [t + dt/2, t + dt]
+// The coarse level is the symplectic scheme with dt, the fine one with dt / 2, each exactly: with one smoothing
+// length everywhere a macro step is two SymplecticVerlet steps of dt / 2, bit for bit. One evaluation of the coarse
+// level per macro step against two of the fine one: the saving is the coarse particles' second evaluation.
+// A passive coarse particle (inside a finer box) only drifts with the velocity the pass fitted; a coarse particle the
+// pass at t + dt/2 turned passive takes no further rate, one it turned active none until the next evaluation.
+//
+// Limits: models' forces on coarse particles are evaluated once per macro step (at the first evaluation); solids and
+// couplings belong in the finest level (the porous blades in the refinement box). The coarse particles' signal speeds
+// are those of their last evaluation, kept by Simulation as a level limit (a restart takes them from the saved rates).
+#pragma once
+
+#include <sphfsi/core/parallel.hpp>
+#include <sphfsi/core/types.hpp>
+
+namespace sphfsi {
+
+struct LocalSymplecticVerlet {
+  static constexpr const char* name = "symplectic-local";
+  static constexpr bool local_time_stepping = true;
+
+  template <class Sim, class T>
+  void step(Sim& sim, T dt) const {
+    auto& p = sim.system().particles();
+    const T t = sim.time();
+    const T half = T(0.5) * dt, quarter = T(0.25) * dt;
+    const T t_half = t + half;  // the end of sub-step 1, as a SymplecticVerlet step of dt / 2 would reach it
+
+    // Sub-step 1.
+    {
+      const auto& coarse = sim.update_time_levels();
+      parallel_for(p.size(), [&](std::size_t i) {
+        p.position_old[i] = p.position[i];
+        p.velocity_old[i] = p.velocity[i];
+        p.density_old[i] = p.density[i];
+        if (p.kind[i] == Kind::solid) return;
+        const T drift = coarse[i] ? half : quarter;
+        p.density[i] = sim.limit_density(i, p.density[i] + drift * p.density_rate[i]);
+        if (p.kind[i] == Kind::fluid) p.position[i] += drift * (p.velocity[i] + p.xsph_velocity[i]);
+      });
+      sim.move_walls(t + quarter, t_half);
+    }
+    sim.evaluate_rates(t + quarter);
+    {
+      const auto& coarse = sim.time_levels();
+      parallel_for(p.size(), [&](std::size_t i) {
+        if (p.kind[i] == Kind::solid) return;
+        if (coarse[i]) {  // at its midpoint: the velocity there
+          if (p.kind[i] == Kind::fluid) p.velocity[i] = p.velocity_old[i] + half * p.acceleration[i];
+          return;
+        }
+        const T e = -half * p.density_rate[i] / p.density[i];
+        p.density[i] = sim.limit_density(i, p.density_old[i] * (T(2) - e) / (T(2) + e));
+        if (p.kind[i] != Kind::fluid) return;
+        p.velocity[i] = p.velocity_old[i] + half * p.acceleration[i];
+        p.position[i] += quarter * (p.velocity[i] + p.xsph_velocity[i]);
+      });
+      sim.move_walls(t_half, t_half);
+    }
+    sim.advance_models(t, half);
+    sim.fluid().keep_fluid_beside_structures(sim.system());
+
+    // Sub-step 2 (a model may have re-sorted, added or removed particles: the levels are marked again).
+    {
+      const auto& coarse = sim.update_time_levels();
+      parallel_for(p.size(), [&](std::size_t i) {
+        if (coarse[i]) return;  // keeps its state at t in the _old fields
+        p.position_old[i] = p.position[i];
+        p.velocity_old[i] = p.velocity[i];
+        p.density_old[i] = p.density[i];
+        if (p.kind[i] == Kind::solid) return;
+        p.density[i] = sim.limit_density(i, p.density[i] + quarter * p.density_rate[i]);
+        if (p.kind[i] == Kind::fluid) p.position[i] += quarter * (p.velocity[i] + p.xsph_velocity[i]);
+      });
+      sim.move_walls(t_half + quarter, t_half);
+    }
+    sim.evaluate_rates(t_half + quarter, true);
+    {
+      const auto& coarse = sim.time_levels();
+      parallel_for(p.size(), [&](std::size_t i) {
+        const Kind kind = p.kind[i];
+        if (kind == Kind::solid) return;
+        if (coarse[i]) {
+          if (kind == Kind::fluid && p.passive[i]) {  // drifts with its fitted velocity
+            p.position[i] += half * p.velocity[i];
+            return;
+          }
+          const T e = -dt * p.density_rate[i] / p.density[i];
+          p.density[i] = sim.limit_density(i, p.density_old[i] * (T(2) - e) / (T(2) + e));
+          if (kind != Kind::fluid) return;
+          p.velocity[i] += half * p.acceleration[i];
+          p.position[i] += half * (p.velocity[i] + p.xsph_velocity[i]);
+          return;
+        }
+        const T e = -half * p.density_rate[i] / p.density[i];
+        p.density[i] = sim.limit_density(i, p.density_old[i] * (T(2) - e) / (T(2) + e));
+        if (kind != Kind::fluid) return;
+        p.velocity[i] = p.velocity_old[i] + half * p.acceleration[i];
+        p.position[i] += quarter * (p.velocity[i] + p.xsph_velocity[i]);
+      });
+      sim.move_walls(t_half + half, t_half + half);
+    }
+    sim.advance_models(t_half, half);
+  }
+};
+
+}  // namespace sphfsi

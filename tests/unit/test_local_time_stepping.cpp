@@ -1,0 +1,252 @@
+// Local time stepping (integrators/local_time_stepping.hpp; issue 9): with one smoothing length a macro step is two
+// symplectic steps, bit for bit; two tanks of different resolutions in one scene each advance as with their own
+// step; the still tank with nested APR boxes settles as with one global step for fewer particle-steps; bad input.
+#include "../../examples/hydrostatic_tank/tank_scene.hpp"
+
+#include <sphfsi/fluid/adaptive_refinement.hpp>
+#include <sphfsi/integrators/local_time_stepping.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+using namespace sphfsi;
+namespace tank = sphfsi::examples::tank;
+
+namespace {
+
+using V2 = Vec<2, double>;
+using LocalTankSimulation = Simulation<tank::System, LocalSymplecticVerlet>;
+
+// A sloshing start: horizontal velocity U sin(pi z / (2 H)) cos(pi (x - x0) / L) in the block [x0, x0 + L] x [0, H].
+void set_sloshing(tank::System& system, double x0, double x1, double depth, double speed) {
+  auto& p = system.particles();
+  const double pi = std::acos(-1.0);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (p.kind[i] != Kind::fluid || p.position[i][0] < x0 || p.position[i][0] > x1) continue;
+    const V2 x = p.position[i];
+    p.velocity[i] = V2(speed * std::sin(0.5 * pi * x[1] / depth) * std::cos(pi * (x[0] - x0) / (x1 - x0)), 0);
+  }
+}
+
+// A tank of width L and depth H at spacing dp with its left wall face at x0, in `system` (dynamic walls, masses
+// rho dp^2 as tank::make_tank gives them).
+void add_tank(tank::System& system, double x0, const tank::TankConfig& cfg, double dp) {
+  const Resolution<double> res{dp, cfg.smoothing_ratio};
+  const std::size_t first = system.particles().size();
+  add_fluid_block(system, V2(x0, 0), V2(x0 + cfg.width, cfg.depth), res, cfg.depth, cfg.gravity);
+  add_box_walls(system, V2(x0, 0), V2(x0 + cfg.width, cfg.wall_height), res, cfg.walls);
+  set_hydrostatic_wall_density(system, cfg.depth, cfg.gravity);
+  auto& p = system.particles();
+  for (std::size_t i = first; i < p.size(); ++i) p.mass[i] = p.density[i] * dp * dp;
+}
+
+tank::System make_system(double x_max, const tank::TankConfig& cfg) {
+  const double margin = 0.5 * cfg.depth;  // room for three wall layers at the coarsest spacing
+  return tank::System(Domain<2, double>(V2(-margin, -margin), V2(x_max + margin, cfg.wall_height + margin)),
+                      Tait<double>(cfg.rho0, cfg.sound_speed()));
+}
+
+// Largest |x_a - x_b| over the particles of `a` with ids in [first, first + count), matched by id in `b` shifted by
+// `offset` (b's id = a's id - offset).
+double largest_position_difference(const tank::System& a, const tank::System& b, std::uint32_t first,
+                                   std::uint32_t count, std::uint32_t offset) {
+  double largest = 0;
+  for (std::uint32_t id = first; id < first + count; ++id) {
+    const V2 xa = a.particles().position[a.particles().slot_of_id(id)];
+    const V2 xb = b.particles().position[b.particles().slot_of_id(id - offset)];
+    largest = std::max(largest, (xa - xb).norm());
+  }
+  return largest;
+}
+
+}  // namespace
+
+TEST_CASE("local time stepping: with one smoothing length a macro step is two symplectic steps, bit for bit",
+          "[local_time_stepping]") {
+  tank::TankConfig cfg;
+  cfg.particles_over_depth = 16;
+  cfg.width = 0.5;
+  auto fluid = tank::fluid_parameters(cfg);
+  tank::System plain_system = tank::make_tank(cfg), local_system = tank::make_tank(cfg);
+  set_sloshing(plain_system, 0, cfg.width, cfg.depth, 0.2);
+  set_sloshing(local_system, 0, cfg.width, cfg.depth, 0.2);
+  const double dt = 0.1 * cfg.dp() * cfg.smoothing_ratio / cfg.sound_speed();
+  TimeStepParameters<double> plain_step, local_step;
+  plain_step.fixed_dt = dt;
+  local_step.fixed_dt = 2 * dt;
+  tank::TankSimulation plain(plain_system, fluid, plain_step);
+  LocalTankSimulation local(local_system, fluid, local_step);
+  for (int k = 0; k < 40; ++k) plain.step();
+  for (int k = 0; k < 20; ++k) local.step();
+  CHECK(local.coarse_particle_count() == 0);
+  CHECK(local.particle_steps() == plain.particle_steps());
+  const auto &a = plain_system.particles(), &b = local_system.particles();
+  REQUIRE(a.size() == b.size());
+  std::size_t differing = 0;
+  double moved = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const std::size_t j = b.slot_of_id(a.id[i]);
+    moved = std::max(moved, (a.position[i] - a.position_old[i]).norm());
+    differing += a.position[i] != b.position[j] || a.velocity[i] != b.velocity[j] || a.density[i] != b.density[j];
+  }
+  INFO("largest displacement in the last step " << moved << " m");
+  CHECK(moved > 0);  // the water moves: the comparison is not of a still state
+  CHECK(differing == 0);
+}
+
+TEST_CASE("local time stepping: a coarse and a fine tank in one scene each advance as with their own step",
+          "[local_time_stepping]") {
+  // Tank A at dp, tank B at dp / 2, side by side without contact; with same_resolution_pairs neither sees the other.
+  // Under local time stepping with the macro step dt, A must follow a run of A alone with dt and B a run of B alone
+  // with dt / 2, to round-off (the neighbour sums are added in another order).
+  tank::TankConfig cfg;
+  cfg.particles_over_depth = 8;
+  cfg.width = 0.4;
+  const double dp = cfg.dp(), gap = 0.3;
+  auto fluid = tank::fluid_parameters(cfg);
+  fluid.same_resolution_pairs = true;
+  const double x_b = cfg.width + gap, x_max = x_b + cfg.width;
+  tank::System both = make_system(x_max, cfg), only_a = make_system(x_max, cfg), only_b = make_system(x_max, cfg),
+               a_half_step = make_system(x_max, cfg);
+  add_tank(both, 0, cfg, dp);
+  const auto count_a = static_cast<std::uint32_t>(both.particles().size());
+  add_tank(both, x_b, cfg, 0.5 * dp);
+  const auto count_b = static_cast<std::uint32_t>(both.particles().size()) - count_a;
+  add_tank(only_a, 0, cfg, dp);
+  add_tank(a_half_step, 0, cfg, dp);
+  add_tank(only_b, x_b, cfg, 0.5 * dp);
+  for (auto* s : {&both, &only_a, &a_half_step}) set_sloshing(*s, 0, cfg.width, cfg.depth, 0.2);
+  for (auto* s : {&both, &only_b}) set_sloshing(*s, x_b, x_max, cfg.depth, 0.2);
+  // The fine tank's acoustic limit is half the coarse one's: dt / 2 at CFL 0.2 of the fine tank.
+  const double dt = 2 * 0.2 * 0.5 * dp * cfg.smoothing_ratio / cfg.sound_speed();
+  auto fixed = [](double step) {
+    TimeStepParameters<double> s;
+    s.fixed_dt = step;
+    return s;
+  };
+  const int macro_steps = 30;
+  LocalTankSimulation local(both, fluid, fixed(dt));
+  tank::TankSimulation run_a(only_a, fluid, fixed(dt)), run_b(only_b, fluid, fixed(0.5 * dt)),
+      run_a_half(a_half_step, fluid, fixed(0.5 * dt));
+  for (int k = 0; k < macro_steps; ++k) {
+    local.step();
+    run_a.step();
+    run_b.step();
+    run_b.step();
+    run_a_half.step();
+    run_a_half.step();
+  }
+  CHECK(local.coarse_particle_count() == count_a);
+  CHECK(local.particle_steps() == double(macro_steps) * (count_a + 2.0 * count_b));
+  const double error_a = largest_position_difference(both, only_a, 0, count_a, 0);
+  const double error_b = largest_position_difference(both, only_b, count_a, count_b, count_a);
+  // The control: A with the fine step instead of its own differs from A with its own by the scheme's O(dt^2) error,
+  // which a comparison at round-off must resolve (otherwise it could not tell the two steps apart).
+  const double step_effect = largest_position_difference(only_a, a_half_step, 0, count_a, 0);
+  const double tolerance = 1e-10 * dp;
+  INFO("coarse tank: " << error_a << " m from its own run; fine tank: " << error_b
+                       << " m; dt against dt / 2 moves A by " << step_effect << " m; tolerance " << tolerance << " m");
+  CHECK(error_a <= tolerance);
+  CHECK(error_b <= tolerance);
+  CHECK(step_effect >= 100 * tolerance);
+}
+
+TEST_CASE("local time stepping: a still tank with nested boxes (dp, dp/2, dp/4) settles as with one global step",
+          "[local_time_stepping][apr][tank]") {
+  // The tank of the APR test in test_particle_refinement.cpp, stepped with the finest level's step (global) and with
+  // the coarse levels at twice it (local): both settle to hydrostatic pressure within 2 % with the same kinetic
+  // energy bound; the local run takes fewer particle-steps, by the fraction of particles in the coarse levels.
+  using TankApr = AdaptiveRefinement<tank::System>;
+  tank::TankConfig cfg;
+  cfg.particles_over_depth = 20;
+  cfg.width = 0.5;
+  const double dp = cfg.dp(), zc = 0.5 * cfg.depth, end_time = 0.5;
+  const std::vector<RefinementBox<2, double>> boxes{{V2(4 * dp, zc - 4 * dp), V2(16 * dp, zc + 4 * dp), 1},
+                                                    {V2(7 * dp, zc - dp), V2(13 * dp, zc + dp), 2}};
+  AdaptiveRefinementParameters<double> params;
+  params.base_spacing = dp;
+  params.transition_width = 2 * dp;
+  params.smoothing_ratio = cfg.smoothing_ratio;
+  auto fluid = tank::fluid_parameters(cfg);
+  fluid.same_resolution_pairs = true;
+  fluid.artificial_viscosity = 0.1;
+  struct Result {
+    double energy = 0, mass_error = 0, p_mid = 0, p_theory = 0, particle_steps = 0;
+    std::size_t steps = 0, lost = 0;
+  };
+  auto run = [&]<class Integrator>(Integrator) {
+    using Sim = Simulation<tank::System, Integrator, TankApr>;
+    tank::System system = tank::make_tank(cfg);
+    Sim sim(system, fluid, {}, TankApr(system.domain(), boxes, params));
+    auto& apr = sim.template model<0>();
+    const double mass0 = apr.active_mass_momentum(system).first;
+    apr.populate(system);
+    Result r;
+    std::size_t samples = 0;
+    sim.run(end_time, [&](Sim& s) {
+      r.lost = std::max(r.lost, tank::particles_outside(system, cfg));
+      if (s.time() < end_time - 0.2) return;
+      const auto& p = system.particles();
+      for (std::size_t i = 0; i < p.size(); ++i)
+        if (p.kind[i] == Kind::fluid && !p.passive[i]) r.energy += 0.5 * p.mass[i] * p.velocity[i].squaredNorm();
+      ++samples;
+    });
+    r.energy /= double(samples);
+    r.mass_error = std::abs(apr.active_mass_momentum(system).first - mass0) / mass0;
+    const auto& p = system.particles();
+    double volume = 0;
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (p.kind[i] == Kind::fluid && !p.passive[i]) volume += p.mass[i] / p.density[i];
+    r.p_mid = tank::shepard_pressure(system, V2(0.5 * cfg.width, zc));
+    r.p_theory = tank::hydrostatic_pressure(cfg, volume / cfg.width, zc);
+    r.particle_steps = sim.particle_steps();
+    r.steps = sim.step_count();
+    return r;
+  };
+  const Result global = run(SymplecticVerlet{});
+  const Result local = run(LocalSymplecticVerlet{});
+  const double fluid_mass = cfg.rho0 * cfg.depth * cfg.width;
+  const double noise_speed = 0.02 * (0.5 * cfg.gravity * cfg.depth) / cfg.sound_speed();
+  const double energy_bound = 0.5 * fluid_mass * noise_speed * noise_speed;
+  INFO("global: " << global.steps << " steps, " << global.particle_steps << " particle-steps, kinetic energy "
+                  << global.energy << " J/m, p_mid " << global.p_mid << " Pa (theory " << global.p_theory
+                  << "); local: " << local.steps << " macro steps, " << local.particle_steps
+                  << " particle-steps, kinetic energy " << local.energy << " J/m, p_mid " << local.p_mid
+                  << " Pa (theory " << local.p_theory << "); bound " << energy_bound << " J/m");
+  for (const Result* r : {&global, &local}) {
+    CHECK(r->lost == 0);
+    CHECK(r->mass_error <= 1e3 * std::numeric_limits<double>::epsilon());
+    CHECK(std::abs(r->p_mid - r->p_theory) / r->p_theory <= 0.02);
+    CHECK(r->energy <= energy_bound);
+  }
+  // The coarse levels (dp, dp / 2) hold most particles: they are stepped half as often.
+  CHECK(local.particle_steps <= 0.75 * global.particle_steps);
+}
+
+TEST_CASE("local time stepping: bad input gives an InputError naming the parameter and its valid range",
+          "[local_time_stepping]") {
+  tank::TankConfig cfg;
+  cfg.particles_over_depth = 8;
+  cfg.width = 0.4;
+  const double x_b = cfg.width + 0.3, x_max = x_b + cfg.width;
+  tank::System both = make_system(x_max, cfg);
+  add_tank(both, 0, cfg, cfg.dp());
+  add_tank(both, x_b, cfg, 0.5 * cfg.dp());
+  SECTION("two resolutions that interact pair-wise cannot step at two rates") {
+    auto fluid = tank::fluid_parameters(cfg);
+    fluid.same_resolution_pairs = false;
+    LocalTankSimulation local(both, fluid);
+    REQUIRE_THROWS_WITH(local.step(), Catch::Contains("same_resolution_pairs") && Catch::Contains("valid"));
+  }
+  SECTION("a fixed macro step above the coarse level's limit") {
+    auto fluid = tank::fluid_parameters(cfg);
+    fluid.same_resolution_pairs = true;
+    TimeStepParameters<double> s;
+    s.fixed_dt = 2 * cfg.dp() * cfg.smoothing_ratio / cfg.sound_speed();  // 2 h / c of the coarse tank
+    LocalTankSimulation local(both, fluid, s);
+    REQUIRE_THROWS_WITH(local.step(), Catch::Contains("fixed_dt") && Catch::Contains("valid range"));
+  }
+}
