@@ -17,6 +17,7 @@
 #include <sphfsi/eos/tait.hpp>
 #include <sphfsi/fluid/adaptive_refinement.hpp>
 #include <sphfsi/fluid/particle_refinement.hpp>
+#include <sphfsi/integrators/local_time_stepping.hpp>
 #include <sphfsi/integrators/simulation.hpp>
 #include <sphfsi/integrators/symplectic.hpp>
 #include <sphfsi/io/command_line.hpp>
@@ -110,6 +111,8 @@ int main(int argc, char** argv) try {
   const bool volume_mass =
       cli.get_switch("volume-mass", true, "apr: passive masses from their SPH volume (else nominal): on | off");
   const bool shift = cli.get_switch("shift", false, "apr: particle shifting of the fine particles: on | off");
+  const bool local_steps = cli.get_switch(
+      "local-steps", false, "apr: local time stepping, the coarse level at twice the fine step: on | off");
   const double shift_coefficient =
       cli.get_number("shift-coefficient", 2, "apr: A of the shift -A h |v| dt grad C, (0, 10]");
   const bool shift_passive =
@@ -169,9 +172,11 @@ int main(int argc, char** argv) try {
   apr_params.shifting.include_passive = shift_passive;
 
   // The same flume run with either refinement model.
-  auto run = [&](auto model) -> int {
+  // The integrator: SymplecticVerlet, or LocalSymplecticVerlet (--local-steps on, apr: the coarse level at twice the
+  // fine step).
+  auto run = [&](auto model, auto integrator) -> int {
     constexpr bool adaptive = std::is_same_v<decltype(model), Adaptive>;
-    using Solver = Simulation<System, SymplecticVerlet, waves::DampingZone<T>, decltype(model)>;
+    using Solver = Simulation<System, decltype(integrator), waves::DampingZone<T>, decltype(model)>;
     Solver sim(system, fluid, {}, damping, std::move(model));
     auto& refinement = sim.template model<1>();
     if constexpr (adaptive) refinement.populate(system);
@@ -257,10 +262,12 @@ int main(int argc, char** argv) try {
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     write_counts(sim.time());
     const auto [made, unmade] = created_removed();
-    fmt::print("{} steps, {:.1f} s wall; {} {}, {} {}; {}mass change {:.2e}; {} fluid particles at the end\n",
-               sim.step_count(), wall, made, adaptive ? "children created" : "splits", unmade,
-               adaptive ? "removed" : "merges", adaptive ? "active " : "", (fluid_mass() - mass0) / mass0,
-               system.particles().count(Kind::fluid));
+    fmt::print(
+        "{} steps ({}), {:.4g} particle-steps, {:.1f} s wall; {} {}, {} {}; {}mass change {:.2e}; {} fluid "
+        "particles at the end\n",
+        sim.step_count(), decltype(integrator)::name, sim.particle_steps(), wall, made,
+        adaptive ? "children created" : "splits", unmade, adaptive ? "removed" : "merges", adaptive ? "active " : "",
+        (fluid_mass() - mass0) / mass0, system.particles().count(Kind::fluid));
     if constexpr (adaptive)
       fmt::print(
           "mass account: largest correction of the edge particles' masses {:.2e} (one pass); momentum account: largest "
@@ -342,8 +349,10 @@ int main(int argc, char** argv) try {
     fmt::print("{}\n", pass ? "PASS" : "FAIL");
     return pass ? 0 : 1;
   };
-  if (apr) return run(Adaptive(system.domain(), boxes, apr_params));
-  return run(Refinement(system.domain(), boxes, params));
+  if (apr && local_steps) return run(Adaptive(system.domain(), boxes, apr_params), LocalSymplecticVerlet{});
+  if (local_steps) throw InputError("--local-steps on: only with --method apr (split and merge pair the two sizes)");
+  if (apr) return run(Adaptive(system.domain(), boxes, apr_params), SymplecticVerlet{});
+  return run(Refinement(system.domain(), boxes, params), SymplecticVerlet{});
 } catch (const std::exception& e) {
   fmt::print(stderr, "refined_wave: {}\n", e.what());
   return 2;

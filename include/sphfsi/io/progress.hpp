@@ -32,7 +32,7 @@ struct ProgressSample {
   std::size_t step{0};                  ///< steps taken
   std::size_t particles{0};             ///< particle count
   double steps_per_second{0};           ///< over the last reporting window
-  double particle_steps_per_second{0};  ///< steps per second times particles
+  double particle_steps_per_second{0};  ///< particles advanced per second (Simulation::particle_steps())
   double eta_seconds{-1};               ///< wall time to end_time, s (negative: not known yet)
 };
 
@@ -121,6 +121,7 @@ class ProgressReporter {
     start_wall_ = last_wall_ = now;
     start_time_ = static_cast<double>(sim.time());
     last_step_ = sim.step_count();
+    if constexpr (requires { sim.particle_steps(); }) last_particle_steps_ = sim.particle_steps();
   }
 
   template <class Sim>
@@ -134,7 +135,11 @@ class ProgressReporter {
     if (window > 0) {
       s.steps_per_second = static_cast<double>(s.step - last_step_) / window;
       s.particle_steps_per_second = s.steps_per_second * static_cast<double>(s.particles);
+      // A Simulation counts what its steps advanced (local time stepping: not every particle in every sub-step).
+      if constexpr (requires { sim.particle_steps(); })
+        s.particle_steps_per_second = (sim.particle_steps() - last_particle_steps_) / window;
     }
+    if constexpr (requires { sim.particle_steps(); }) last_particle_steps_ = sim.particle_steps();
     const double elapsed = seconds(now - start_wall_);
     const double simulated = s.time - start_time_;
     if (elapsed > 0 && simulated > 0) s.eta_seconds = std::max(0.0, end_time_ - s.time) * elapsed / simulated;
@@ -162,7 +167,7 @@ class ProgressReporter {
   bool in_place_{false};
   bool started_{false};
   Clock::time_point start_wall_{}, last_wall_{};
-  double start_time_{0};
+  double start_time_{0}, last_particle_steps_{0};
   std::size_t last_step_{0}, lines_{0}, last_length_{0};
 };
 
