@@ -136,6 +136,10 @@ class Simulation {
     if constexpr (local_time_stepping) {
       update_time_levels();
       particle_steps_ += 2.0 * n - double(coarse_count_);
+      const auto& p = system_.particles();
+      passive_at_start_.assign(p.id_capacity(), 0);
+      for (std::size_t i = 0; i < p.size(); ++i)
+        if (p.kind[i] == Kind::fluid && p.passive[i]) passive_at_start_[p.id[i]] = 1;
     } else {
       particle_steps_ += n;
     }
@@ -272,6 +276,11 @@ class Simulation {
                       "smoothing length",
                       coarse_count_, h_min));
     return coarse_;
+  }
+  /// Local time stepping: whether the particle with this id was a passive fluid particle at the start of the step
+  /// being taken (false for ids created since).
+  bool passive_at_step_start(std::uint32_t id) const noexcept {
+    return id < passive_at_start_.size() && passive_at_start_[id] != 0;
   }
   /// The flags of the last update_time_levels() (or evaluation).
   const std::vector<std::uint8_t>& time_levels() const noexcept { return coarse_; }
@@ -462,6 +471,7 @@ class Simulation {
   // Local time stepping: the coarse level's flags per slot, its size, the levels' last stability limits (without
   // the CFL factor) and the coarse rates kept across a frozen evaluation.
   std::vector<std::uint8_t> coarse_;
+  std::vector<std::uint8_t> passive_at_start_;  // by id, at the start of the step being taken
   std::size_t coarse_count_{0};
   T fine_stable_{std::numeric_limits<T>::max()}, coarse_stable_{std::numeric_limits<T>::max()};
   bool level_steps_known_{false};
