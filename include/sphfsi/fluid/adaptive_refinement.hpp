@@ -45,8 +45,9 @@
 // active momentum the pass changed (the status changes and the mass account's rescaling carry momentum) back to the
 // same particles as one velocity shift dP / M_edge, so the active momentum is conserved to round-off too; the largest
 // shift is reported (AdaptiveRefinementCounts::momentum_correction). The model keeps no state a restart needs (levels
-// are smoothing lengths, passive flags and masses are particle fields). One global time step, set by the finest
-// particles.
+// are smoothing lengths, passive flags and masses are particle fields). Time step: one global step set by the finest
+// particles (SymplecticVerlet), or the coarse levels at twice the finest level's step (LocalSymplecticVerlet,
+// integrators/local_time_stepping.hpp; the pass then runs after each of the finest level's two sub-steps).
 //
 // Walls: a box that comes within a kernel support of a wall needs wall particles at its own spacing there (the scene
 // adds them beside the coarse ones; each resolution sees only its own); populate() checks it. Couplings: the porous

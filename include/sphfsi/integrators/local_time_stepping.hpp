@@ -2,10 +2,11 @@
 // integrators/symplectic.hpp with two time levels. The finest particles (and the solids' models) advance in two
 // sub-steps of dt / 2, the coarser fluid and wall particles in one step of dt, so that a particle is stepped at the
 // rate its own resolution needs (the acoustic limit h / c scales with h). Multi-rate integration of this kind is
-// the local (adaptive) time stepping of Lowe, Wang & Zhu 2019 and the multiple time stepping of Zhang, Rezavand &
-// Hu 2021 (J. Comput. Phys. 429:110028) for a fine solid in a coarse fluid; here it is applied to the resolutions of
-// adaptive particle refinement (fluid/adaptive_refinement.hpp), which interact only through passive particles
-// (FluidParameters::same_resolution_pairs), so that no SPH pair joins the two time levels.
+// the hierarchical power-of-two time bins of astrophysical SPH (Springel 2005, MNRAS 364:1105), the regional time
+// stepping of weakly compressible SPH (Goswami & Batty 2014, Eurographics short papers) and the multiple time
+// stepping of Zhang, Rezavand & Hu 2021 (J. Comput. Phys. 429:110028) for a fine solid in a coarse fluid. Here it is
+// applied to the resolutions of adaptive particle refinement (fluid/adaptive_refinement.hpp), which interact only
+// through passive particles (FluidParameters::same_resolution_pairs), so that no SPH pair joins the two time levels.
 //
 // One macro step [t, t + dt], f the finest level, c the coarse level (Simulation::time_levels()):
 //   sub-step 1:  f drifts dt/4, c drifts dt/2 to its midpoint:  x^{n+1/2}_c = x^n_c + dt/2 v^n_c,  rho likewise
