@@ -37,6 +37,7 @@
 
 #include <sphfsi/core/parallel.hpp>
 #include <sphfsi/core/types.hpp>
+#include <sphfsi/integrators/symplectic.hpp>
 
 namespace sphfsi {
 
@@ -55,15 +56,8 @@ struct LocalSymplecticVerlet {
     // Sub-step 1.
     {
       const auto& coarse = sim.update_time_levels();
-      parallel_for(p.size(), [&](std::size_t i) {
-        p.position_old[i] = p.position[i];
-        p.velocity_old[i] = p.velocity[i];
-        p.density_old[i] = p.density[i];
-        if (p.kind[i] == Kind::solid) return;
-        const T drift = coarse[i] ? half : quarter;
-        p.density[i] = sim.limit_density(i, p.density[i] + drift * p.density_rate[i]);
-        if (p.kind[i] == Kind::fluid) p.position[i] += drift * (p.velocity[i] + p.xsph_velocity[i]);
-      });
+      parallel_for(p.size(),
+                   [&](std::size_t i) { SymplecticVerlet::begin_particle(sim, p, i, coarse[i] ? dt : half); });
       sim.move_walls(t + quarter, t_half);
     }
     sim.evaluate_rates(t + quarter, true);
@@ -75,11 +69,7 @@ struct LocalSymplecticVerlet {
           if (active_fluid(i)) p.velocity[i] = p.velocity_old[i] + half * p.acceleration[i];
           return;
         }
-        const T e = -half * p.density_rate[i] / p.density[i];
-        p.density[i] = sim.limit_density(i, p.density_old[i] * (T(2) - e) / (T(2) + e));
-        if (p.kind[i] != Kind::fluid) return;
-        p.velocity[i] = p.velocity_old[i] + half * p.acceleration[i];
-        p.position[i] += quarter * (p.velocity[i] + p.xsph_velocity[i]);
+        SymplecticVerlet::finish_particle(sim, p, i, half);
       });
       sim.move_walls(t_half, t_half);
     }
@@ -95,12 +85,7 @@ struct LocalSymplecticVerlet {
           if (active_fluid(i) && !turned_active(i)) p.velocity[i] -= half * p.acceleration[i];
           return;
         }
-        p.position_old[i] = p.position[i];
-        p.velocity_old[i] = p.velocity[i];
-        p.density_old[i] = p.density[i];
-        if (p.kind[i] == Kind::solid) return;
-        p.density[i] = sim.limit_density(i, p.density[i] + quarter * p.density_rate[i]);
-        if (p.kind[i] == Kind::fluid) p.position[i] += quarter * (p.velocity[i] + p.xsph_velocity[i]);
+        SymplecticVerlet::begin_particle(sim, p, i, half);
       });
       sim.move_walls(t_half + quarter, t_half);
     }
@@ -129,11 +114,7 @@ struct LocalSymplecticVerlet {
           p.position[i] += half * (p.velocity[i] + p.xsph_velocity[i]);
           return;
         }
-        const T e = -half * p.density_rate[i] / p.density[i];
-        p.density[i] = sim.limit_density(i, p.density_old[i] * (T(2) - e) / (T(2) + e));
-        if (kind != Kind::fluid) return;
-        p.velocity[i] = p.velocity_old[i] + half * p.acceleration[i];
-        p.position[i] += quarter * (p.velocity[i] + p.xsph_velocity[i]);
+        SymplecticVerlet::finish_particle(sim, p, i, half);
       });
       sim.move_walls(t_half + half, t_half + half);
     }
