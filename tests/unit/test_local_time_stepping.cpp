@@ -2,6 +2,7 @@
 // symplectic steps, bit for bit; two tanks of different resolutions in one scene each advance as with their own
 // step; the still tank with nested APR boxes settles as with one global step for fewer particle-steps; bad input.
 #include "../../examples/hydrostatic_tank/tank_scene.hpp"
+#include "nested_apr_tank.hpp"
 
 #include <sphfsi/fluid/adaptive_refinement.hpp>
 #include <sphfsi/integrators/local_time_stepping.hpp>
@@ -160,19 +161,12 @@ TEST_CASE("local time stepping: a still tank with nested boxes (dp, dp/2, dp/4) 
   // the coarse levels at twice it (local): both settle to hydrostatic pressure within 2 % with the same kinetic
   // energy bound; the local run takes fewer particle-steps, by the fraction of particles in the coarse levels.
   using TankApr = AdaptiveRefinement<tank::System>;
-  tank::TankConfig cfg;
-  cfg.particles_over_depth = 20;
-  cfg.width = 0.5;
-  const double dp = cfg.dp(), zc = 0.5 * cfg.depth, end_time = 0.5;
-  const std::vector<RefinementBox<2, double>> boxes{{V2(4 * dp, zc - 4 * dp), V2(16 * dp, zc + 4 * dp), 1},
-                                                    {V2(7 * dp, zc - dp), V2(13 * dp, zc + dp), 2}};
-  AdaptiveRefinementParameters<double> params;
-  params.base_spacing = dp;
-  params.transition_width = 2 * dp;
-  params.smoothing_ratio = cfg.smoothing_ratio;
-  auto fluid = tank::fluid_parameters(cfg);
-  fluid.same_resolution_pairs = true;
-  fluid.artificial_viscosity = 0.1;
+  const tests::NestedAprTank apr_tank = tests::nested_apr_tank();
+  const tank::TankConfig& cfg = apr_tank.cfg;
+  const auto& boxes = apr_tank.boxes;
+  const auto& params = apr_tank.params;
+  const auto& fluid = apr_tank.fluid;
+  const double dp = cfg.dp(), zc = apr_tank.mid_depth, end_time = 0.5;
   struct Result {
     double energy = 0, mass_error = 0, p_mid = 0, p_theory = 0, particle_steps = 0;
     std::size_t steps = 0, lost = 0;

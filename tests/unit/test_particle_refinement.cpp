@@ -2,6 +2,7 @@
 // (fluid/particle_refinement.hpp, Vacondio et al. 2013), hysteresis at a box edge, bad input, a checkpoint with
 // retired ids, and the hydrostatic tank with a refined band (two levels: dp, dp/2, dp/4).
 #include "../../examples/refined_tank/refined_tank_scene.hpp"
+#include "nested_apr_tank.hpp"
 
 #include <sphfsi/fluid/adaptive_refinement.hpp>
 #include <sphfsi/io/checkpoint.hpp>
@@ -597,19 +598,12 @@ TEST_CASE("adaptive refinement: a still tank with nested boxes (dp, dp/2, dp/4) 
           "[refinement][apr][tank]") {
   using TankApr = AdaptiveRefinement<tank::System>;
   using TankAprSimulation = Simulation<tank::System, SymplecticVerlet, TankApr>;
-  tank::TankConfig cfg;
-  cfg.particles_over_depth = 20;
-  cfg.width = 0.5;
-  const double dp = cfg.dp(), zc = 0.5 * cfg.depth, end_time = 0.5;
-  const std::vector<RefinementBox<2, double>> boxes{{V2(4 * dp, zc - 4 * dp), V2(16 * dp, zc + 4 * dp), 1},
-                                                    {V2(7 * dp, zc - dp), V2(13 * dp, zc + dp), 2}};
-  AdaptiveRefinementParameters<double> params;
-  params.base_spacing = dp;
-  params.transition_width = 2 * dp;
-  params.smoothing_ratio = cfg.smoothing_ratio;
-  auto fluid = tank::fluid_parameters(cfg);
-  fluid.same_resolution_pairs = true;
-  fluid.artificial_viscosity = 0.1;
+  const tests::NestedAprTank apr_tank = tests::nested_apr_tank();
+  const tank::TankConfig& cfg = apr_tank.cfg;
+  const auto& boxes = apr_tank.boxes;
+  const auto& params = apr_tank.params;
+  const auto& fluid = apr_tank.fluid;
+  const double dp = cfg.dp(), zc = apr_tank.mid_depth, end_time = 0.5;
   auto active_energy = [](const tank::System& system) {
     const auto& p = system.particles();
     double e = 0;
