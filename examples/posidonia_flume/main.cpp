@@ -67,6 +67,9 @@ struct Options {
   bool guard{true};
   // --refine on: the coarse fluid steps at twice the fine step (integrators/local_time_stepping.hpp).
   bool local_steps{false};
+  // --uniform-viscosity on: alpha applies at the plants' smoothing length and scales as h_ref / h elsewhere, so the
+  // coarse fluid has the fine fluid's viscosity (FluidParameters::viscosity_reference_smoothing_length).
+  bool uniform_viscosity{false};
   std::filesystem::path out;
   std::filesystem::path empty_from;  // reuse DIR/empty/wave_heights.csv of an earlier run instead of the empty run
   std::filesystem::path reference;   // the uniformly fine run to compare a refined run with (DIR/plants)
@@ -175,6 +178,7 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
   fluid.thin_structure_visibility = o.visibility;
   fluid.thin_structure_guard = o.guard;
   fluid.same_resolution_pairs = Refined;  // adaptive refinement: each resolution sees only its own particles
+  if (o.uniform_viscosity) fluid.viscosity_reference_smoothing_length = g.smoothing_ratio * scene.plant_dp();
 
   TimeStepParameters<T> stepping;
   stepping.cfl = T(o.cfl);
@@ -755,6 +759,10 @@ int main(int argc, char** argv) try {
       cli.get_switch("shift-passive", true, "refinement: shift the passive fine particles too: on | off");
   o.local_steps = cli.get_switch("local-steps", false,
                                  "refinement: local time stepping, the coarse fluid at twice the fine step: on | off");
+  o.uniform_viscosity = cli.get_switch(
+      "uniform-viscosity", false,
+      "alpha at the plants' smoothing length, scaled as h_ref / h elsewhere (the same nu = alpha h c0 / 8 at both "
+      "resolutions): on | off");
   o.reference = cli.get("reference", "",
                         "with --refine on: compare with the uniformly fine run in DIR (H within 2 %, tip motion within "
                         "5 %, 2.5 times fewer particle-steps; exit 5 if not)");

@@ -112,3 +112,66 @@ TEST_CASE("mixed resolution: the kernel sums stay consistent across a 2:1 jump",
   CHECK(worst_shepard_jump > worst_shepard_far);  // the jump is seen
   CHECK(worst_shepard_jump < 0.1 * coarse * grad);
 }
+
+namespace {
+
+// Viscous acceleration of every interior fluid particle of a uniform block at spacing dp under the shear wave
+// u = (U sin(k y), 0): the acceleration with the artificial viscosity minus the one without (pressure, continuity
+// and the lattice's own residual cancel in the difference). Returns the effective viscosity nu of the fit
+// a_x = -nu k^2 u_x over the particles at least one support from every edge.
+double shear_wave_viscosity(double dp, double viscosity_h) {
+  constexpr double U = 0.05, length = 0.2, k = 2 * 3.14159265358979323846 / length;
+  System system(Domain<2, double>(V(-0.05, -0.05), V(0.25, 0.25)), Tait<double>(1000, 20));
+  add_fluid_block(system, V(0, 0), V(length, length), Resolution<double>{dp, 1.3}, 0.0, 0);
+  auto& p = system.particles();
+  for (std::size_t i = 0; i < p.size(); ++i) p.velocity[i] = V(U * std::sin(k * p.position[i][1]), 0);
+  system.update_neighbors();
+  system.update_pressure();
+  const auto rates = [&](double alpha) {
+    FluidParameters<2, double> params;
+    params.gravity = V::Zero();
+    params.density_diffusion = 0;
+    params.artificial_viscosity = alpha;
+    params.viscosity_reference_smoothing_length = viscosity_h;
+    WcsphFluid<System> fluid(params);
+    fluid.compute_rates(system);
+    return p.acceleration;
+  };
+  const auto with = rates(0.1), without = rates(0);
+  double uu = 0, ua = 0;
+  const double reach = 2 * 1.3 * dp;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const V x = p.position[i];
+    if (x[0] < reach || x[0] > length - reach || x[1] < reach || x[1] > length - reach) continue;
+    const double u = p.velocity[i][0];
+    uu += u * u;
+    ua += u * (with[i][0] - without[i][0]);
+  }
+  return -ua / uu / (k * k);
+}
+
+}  // namespace
+
+TEST_CASE("mixed resolution: a reference smoothing length gives the artificial viscosity one nu at every resolution",
+          "[mixed_resolution]") {
+  // Monaghan's artificial viscosity acts as a viscosity nu proportional to alpha h c0 (Monaghan 2005, Rep. Prog. Phys.
+  // 68:1703, sec. 4.5): at twice the spacing a shear wave decays twice as fast. With FluidParameters::
+  // viscosity_reference_smoothing_length = h_ref a pair uses alpha h_ref / h, so both resolutions get the nu of h_ref.
+  // The two lattices resolve the wave with 20 and 40 spacings per wavelength; their fitted nu differ by the coarse
+  // one's discretisation error, of the order of a centred difference's (k dp)^2 / 12 = 0.8 %: bound 3 %.
+  const double coarse_h = 1.3 * coarse, fine_h = 1.3 * fine;
+  const double nu_fine = shear_wave_viscosity(fine, 0);
+  const double nu_coarse = shear_wave_viscosity(coarse, 0);
+  const double nu_coarse_referred = shear_wave_viscosity(coarse, fine_h);
+  INFO("nu: fine " << nu_fine << ", coarse " << nu_coarse << ", coarse with h_ref = fine h " << nu_coarse_referred
+                   << " m^2/s");
+  CHECK(nu_fine > 0);
+  CHECK(nu_coarse / nu_fine == Approx(coarse_h / fine_h).epsilon(0.03));  // alpha alone: nu grows with h
+  CHECK(nu_coarse_referred / nu_fine == Approx(1).epsilon(0.03));
+  // h_ref equal to the particles' own h is the unscaled viscosity
+  CHECK(shear_wave_viscosity(coarse, coarse_h) == Approx(nu_coarse).epsilon(1e-12));
+  FluidParameters<2, double> bad;
+  bad.viscosity_reference_smoothing_length = -0.01;
+  CHECK_THROWS_WITH(bad.validate(),
+                    Catch::Contains("viscosity_reference_smoothing_length") && Catch::Contains("[0, inf)"));
+}

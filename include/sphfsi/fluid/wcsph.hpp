@@ -5,6 +5,8 @@
 //   momentum       dv_a/dt   = -sum_b m_b (p_a/rho_a^2 + p_b/rho_b^2 + Pi_ab) grad + g        (Monaghan 1992, 3.3)
 //   art. viscosity Pi_ab = -alpha c_ab mu_ab / rho_ab,  mu_ab = h v_ab.x_ab / (r^2 + 0.01 h^2), v_ab.x_ab < 0
 //                                                                                            (Monaghan 1992, 4.1)
+//                  with FluidParameters::viscosity_reference_smoothing_length h_ref > 0: alpha h_ref / h in place of
+//                  alpha (mu_ab with h_ref), so that nu ~ alpha h c0 is the same at every resolution of a scene
 //   laminar visc.  dv_a/dt += sum_b m_b nu (rho_a + rho_b)/(rho_a rho_b) x_ab.grad/(r^2 + eta^2) v_ab
 //                                                                            (Morris, Fox & Zhu 1997, eq. 8)
 //   delta-SPH      drho_a/dt += delta h c0 sum_b V_b 2 (rho_ab - rho_ab^H) x_ab.grad / (r^2 + eta^2)
@@ -78,9 +80,14 @@ template <int Dim, Real T>
 struct FluidParameters {
   Vec<Dim, T> gravity = standard_gravity<Dim, T>();  ///< m/s^2
   T artificial_viscosity{T(0.01)};                   ///< alpha of Monaghan's artificial viscosity, [0, 1]
-  T density_diffusion{T(0.1)};                       ///< delta of delta-SPH, [0, 1] (0 switches it off)
-  T xsph{T(0)};                                      ///< epsilon of XSPH, [0, 1)
-  T kinematic_viscosity{T(0)};                       ///< laminar viscosity nu, m^2/s (0: none)
+  /// Smoothing length h_ref (m) at which `artificial_viscosity` applies when particles of several sizes share a scene
+  /// (0: alpha at every h). A pair of smoothing length h then uses alpha h_ref / h, so the effective viscosity
+  /// nu, proportional to alpha h c0, is the same at every resolution: coarse fluid no longer damps a wave twice as fast
+  /// as the fine fluid it surrounds (docs/variable-resolution.md, session 20).
+  T viscosity_reference_smoothing_length{T(0)};
+  T density_diffusion{T(0.1)};  ///< delta of delta-SPH, [0, 1] (0 switches it off)
+  T xsph{T(0)};                 ///< epsilon of XSPH, [0, 1)
+  T kinematic_viscosity{T(0)};  ///< laminar viscosity nu, m^2/s (0: none)
   WallModel walls{WallModel::dynamic};
   RepulsiveForceParameters<T> repulsive{};  ///< used when walls == repulsive
   /// Artificial viscosity between fluid and dynamic wall particles too (true, the usual DBC practice: a no-slip-like
@@ -109,6 +116,8 @@ struct FluidParameters {
   void validate() const {
     for (int d = 0; d < Dim; ++d) require_finite("FluidParameters::gravity", gravity[d]);
     require_in_range("FluidParameters::artificial_viscosity (alpha)", artificial_viscosity, T(0), T(1));
+    require_non_negative("FluidParameters::viscosity_reference_smoothing_length (m)",
+                         viscosity_reference_smoothing_length);
     require_in_range("FluidParameters::density_diffusion (delta)", density_diffusion, T(0), T(1));
     require_in_range("FluidParameters::xsph (epsilon)", xsph, T(0), T(0.999));
     require_non_negative("FluidParameters::kinematic_viscosity (m^2/s)", kinematic_viscosity);
@@ -429,6 +438,7 @@ class WcsphFluid {
     const T c0 = system.eos().reference_sound_speed();
     const Vector g = params_.gravity;
     const T alpha = params_.artificial_viscosity;
+    const T h_viscosity = params_.viscosity_reference_smoothing_length;  // 0: the pair's own h
     const T delta = params_.density_diffusion;
     const T eps_xsph = params_.xsph;
     const T nu = params_.kinematic_viscosity;
@@ -491,7 +501,9 @@ class WcsphFluid {
       T drho_b = ma * continuity;
       const T rho_b = rho[b];
       const bool viscous_pair = (fluid_a && fluid_b) || params_.wall_artificial_viscosity;
-      const T pi_ab = vr < T(0) && viscous_pair ? -alpha * (ca + c[b]) * mu / (rho_a + rho_b) : T(0);
+      // Pi_ab with alpha h_ref / h in place of alpha when a reference smoothing length is set: the same nu everywhere
+      const T mu_viscous = h_viscosity > T(0) ? h_viscosity * vr * inverse_distance2 : mu;
+      const T pi_ab = vr < T(0) && viscous_pair ? -alpha * (ca + c[b]) * mu_viscous / (rho_a + rho_b) : T(0);
       const T pb = pressure_term[b];
       const T force = pa + pb + pi_ab;
       const T laminar =

@@ -331,7 +331,8 @@ std::vector<typename Sim::scalar_type> fluid_parameter_list(const Sim& sim) {
                    f.repulsive.water_level,
                    f.repulsive.local_depth,
                    T(f.repulsive.vertical_axis),
-                   T(f.same_resolution_pairs ? 1 : 0)};
+                   T(f.same_resolution_pairs ? 1 : 0),
+                   f.viscosity_reference_smoothing_length};
   for (int d = 0; d < Sim::Dim; ++d) v.push_back(f.gravity[d]);
   return v;
 }
