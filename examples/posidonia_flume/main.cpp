@@ -761,8 +761,8 @@ int main(int argc, char** argv) try {
                                  "refinement: local time stepping, the coarse fluid at twice the fine step: on | off");
   o.uniform_viscosity = cli.get_switch(
       "uniform-viscosity", false,
-      "alpha at the plants' smoothing length, scaled as h_ref / h elsewhere (the same nu = alpha h c0 / 8 at both "
-      "resolutions): on | off");
+      "alpha at the plants' smoothing length, scaled as h_ref / h elsewhere (the same nu, proportional to alpha h c0, "
+      "at both resolutions): on | off");
   o.reference = cli.get("reference", "",
                         "with --refine on: compare with the uniformly fine run in DIR (H within 2 %, tip motion within "
                         "5 %, 2.5 times fewer particle-steps; exit 5 if not)");

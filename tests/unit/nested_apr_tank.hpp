@@ -16,7 +16,33 @@ struct NestedAprTank {
   std::vector<RefinementBox<2, double>> boxes;
   AdaptiveRefinementParameters<double> params;
   FluidParameters<2, double> fluid;  ///< same_resolution_pairs, artificial viscosity 0.1
+
+  /// Kinetic energy bound of a settled tank: acoustic noise whose pressure amplitude is 2 % of the mid-depth pressure,
+  /// u = 0.02 (rho g H / 2) / (rho c0), KE = M u^2 / 2 with M the fluid mass (J/m).
+  double kinetic_energy_bound() const {
+    const double fluid_mass = cfg.rho0 * cfg.depth * cfg.width;
+    const double noise_speed = 0.02 * (0.5 * cfg.gravity * cfg.depth) / cfg.sound_speed();
+    return 0.5 * fluid_mass * noise_speed * noise_speed;
+  }
 };
+
+/// Kinetic energy of the active fluid (passive particles are a second copy of the same water), J/m.
+inline double active_kinetic_energy(const examples::tank::System& system) {
+  const auto& p = system.particles();
+  double e = 0;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (p.kind[i] == Kind::fluid && !p.passive[i]) e += 0.5 * p.mass[i] * p.velocity[i].squaredNorm();
+  return e;
+}
+
+/// SPH volume of the active fluid, m^2.
+inline double active_volume(const examples::tank::System& system) {
+  const auto& p = system.particles();
+  double volume = 0;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (p.kind[i] == Kind::fluid && !p.passive[i]) volume += p.mass[i] / p.density[i];
+  return volume;
+}
 
 inline NestedAprTank nested_apr_tank() {
   using V2 = Vec<2, double>;

@@ -163,10 +163,7 @@ TEST_CASE("local time stepping: a still tank with nested boxes (dp, dp/2, dp/4) 
   using TankApr = AdaptiveRefinement<tank::System>;
   const tests::NestedAprTank apr_tank = tests::nested_apr_tank();
   const tank::TankConfig& cfg = apr_tank.cfg;
-  const auto& boxes = apr_tank.boxes;
-  const auto& params = apr_tank.params;
-  const auto& fluid = apr_tank.fluid;
-  const double dp = cfg.dp(), zc = apr_tank.mid_depth, end_time = 0.5;
+  const double zc = apr_tank.mid_depth, end_time = 0.5;
   struct Result {
     double energy = 0, mass_error = 0, p_mid = 0, p_theory = 0, particle_steps = 0;
     std::size_t steps = 0, lost = 0;
@@ -174,7 +171,7 @@ TEST_CASE("local time stepping: a still tank with nested boxes (dp, dp/2, dp/4) 
   auto run = [&]<class Integrator>(Integrator) {
     using Sim = Simulation<tank::System, Integrator, TankApr>;
     tank::System system = tank::make_tank(cfg);
-    Sim sim(system, fluid, {}, TankApr(system.domain(), boxes, params));
+    Sim sim(system, apr_tank.fluid, {}, TankApr(system.domain(), apr_tank.boxes, apr_tank.params));
     auto& apr = sim.template model<0>();
     const double mass0 = apr.active_mass_momentum(system).first;
     apr.populate(system);
@@ -183,28 +180,20 @@ TEST_CASE("local time stepping: a still tank with nested boxes (dp, dp/2, dp/4) 
     sim.run(end_time, [&](Sim& s) {
       r.lost = std::max(r.lost, tank::particles_outside(system, cfg));
       if (s.time() < end_time - 0.2) return;
-      const auto& p = system.particles();
-      for (std::size_t i = 0; i < p.size(); ++i)
-        if (p.kind[i] == Kind::fluid && !p.passive[i]) r.energy += 0.5 * p.mass[i] * p.velocity[i].squaredNorm();
+      r.energy += tests::active_kinetic_energy(system);
       ++samples;
     });
     r.energy /= double(samples);
     r.mass_error = std::abs(apr.active_mass_momentum(system).first - mass0) / mass0;
-    const auto& p = system.particles();
-    double volume = 0;
-    for (std::size_t i = 0; i < p.size(); ++i)
-      if (p.kind[i] == Kind::fluid && !p.passive[i]) volume += p.mass[i] / p.density[i];
     r.p_mid = tank::shepard_pressure(system, V2(0.5 * cfg.width, zc));
-    r.p_theory = tank::hydrostatic_pressure(cfg, volume / cfg.width, zc);
+    r.p_theory = tank::hydrostatic_pressure(cfg, tests::active_volume(system) / cfg.width, zc);
     r.particle_steps = sim.particle_steps();
     r.steps = sim.step_count();
     return r;
   };
   const Result global = run(SymplecticVerlet{});
   const Result local = run(LocalSymplecticVerlet{});
-  const double fluid_mass = cfg.rho0 * cfg.depth * cfg.width;
-  const double noise_speed = 0.02 * (0.5 * cfg.gravity * cfg.depth) / cfg.sound_speed();
-  const double energy_bound = 0.5 * fluid_mass * noise_speed * noise_speed;
+  const double energy_bound = apr_tank.kinetic_energy_bound();
   INFO("global: " << global.steps << " steps, " << global.particle_steps << " particle-steps, kinetic energy "
                   << global.energy << " J/m, p_mid " << global.p_mid << " Pa (theory " << global.p_theory
                   << "); local: " << local.steps << " macro steps, " << local.particle_steps
