@@ -64,7 +64,7 @@ for r in results:
           f"{r['end_time']:.3f} | {dx} | {dy} | {r['max_stretch']:.2f} | {int(r['fluid_inside_max'])} | {blew} |")
 
 os.makedirs(os.path.join(docs, "img"), exist_ok=True)
-markers = {"repulsive": "o", "interface": "s", "stress": "^"}
+markers = {"repulsive": "o", "interface": "s", "interface-mirror": "x", "stress": "^"}
 colors = {"tl": "tab:blue", "ul": "tab:orange", "ul-gms": "tab:green", "ul-v1": "tab:gray"}
 fig, axes = plt.subplots(1, 2, figsize=(11, 4))
 for ax, key, ref in ((axes[0], "rms_dx", 3.9), (axes[1], "rms_dy", 1.8)):
@@ -75,7 +75,7 @@ for ax, key, ref in ((axes[0], "rms_dx", 3.9), (axes[1], "rms_dy", 1.8)):
         marker = markers[r["coupling"]] if r["refinement"] == 1 else "D"
         ax.loglog(r["wall_s"], y, marker, color=colors[r["solid"]],
                   mfc="none" if r["blew_up"] else colors[r["solid"]], ms=5 + r["res"] / 20)
-        label = str(r["res"]) if scored else f"{r['res']}: stopped at {r['end_time']:.3f} s"
+        label = str(r["res"])  # stopped runs: where they stopped is in the table
         if r["refinement"] != 1:
             label += f", gate dp/{r['refinement']}"
         ax.annotate(label, (r["wall_s"], y), fontsize=6)
@@ -90,7 +90,7 @@ for c, m in markers.items():
 for s, col in colors.items():
     axes[0].plot([], [], "o", color=col, label=f"solid {s}")
 axes[0].plot([], [], "o", mfc="none", color="gray", label="stopped (blow-up / break)")
-axes[0].plot([], [], "D", color="gray", label="repulsive, gate finer than the fluid")
+axes[0].plot([], [], "D", color="gray", label="gate finer than the fluid")
 axes[0].legend(fontsize=7)
 fig.suptitle("Antoci gate: error against cost (label = A/dp)")
 fig.tight_layout()
@@ -114,3 +114,43 @@ for ax, key in ((axes[0], "dx"), (axes[1], "dy")):
 axes[0].legend(fontsize=7)
 fig.tight_layout()
 fig.savefig(os.path.join(docs, "img", "coupling_tip_curves.png"), dpi=120)
+
+# Code-to-code: RMS difference of each A/dp = 80 run from the published simulations at t = 0.04 ... 0.36 s.
+published = {}
+with open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data",
+                       "antoci2007_gate_tip_published_simulations.csv")) as f:
+    for row in list(csv.reader(line for line in f if not line.startswith("#")))[1:]:
+        published.setdefault((row[0], row[1]), []).append((float(row[2]), float(row[3])))
+
+
+def interpolate(ts, vs, t):
+    """Linear interpolation, held at the ends (Yang 2012's digitized curve stops at 0.354 s, before 0.36 s)."""
+    pairs = sorted(zip(ts, vs))
+    if t <= pairs[0][0]:
+        return pairs[0][1]
+    if t >= pairs[-1][0]:
+        return pairs[-1][1]
+    for (t0, v0), (t1, v1) in zip(pairs, pairs[1:]):
+        if t0 <= t <= t1:
+            return v0 + (v1 - v0) * (t - t0) / (t1 - t0) if t1 > t0 else v0
+    return float("nan")
+
+
+times = [0.04 * k for k in range(1, 10)]
+methods = sorted({m for m, _ in published})
+print("\n| run (A/dp = 80) | " + " | ".join(f"vs {m}: dx / dy (mm)" for m in methods) + " |")
+print("|---|" + "---|" * len(methods))
+for r in results:
+    if r["res"] != 80 or r["dir"] is None or r["refinement"] != 1 or r["blew_up"]:
+        continue
+    tip = read(os.path.join(r["dir"], "gate_tip.csv"))
+    cells = []
+    for m in methods:
+        rms = []
+        for key, comp in (("dx", "x"), ("dy", "y")):
+            ref = published[(m, comp)]
+            diff = [interpolate(tip["t"], tip[key], t) - interpolate([p[0] for p in ref], [p[1] for p in ref], t)
+                    for t in times]
+            rms.append(1e3 * (sum(d * d for d in diff) / len(diff)) ** 0.5)
+        cells.append(f"{rms[0]:.1f} / {rms[1]:.1f}")
+    print(f"| {r['coupling']} / {r['solid']} | " + " | ".join(cells) + " |")

@@ -1,7 +1,8 @@
 """Snapshots of the Antoci gate for each coupling (benchmarks/run_coupling_comparison.sh output).
 
 usage: /usr/bin/python3 benchmarks/coupling_snapshots.py <runs folder> <resolution> <png>
-Reads the second VTK snapshot (t = 0.1 s with --snapshot-interval 0.1, or the one written at a blow-up) of <coupling>_tl_<resolution> for each coupling and draws fluid (coloured by speed),
+Reads the second VTK snapshot (t = 0.1 s with --snapshot-interval 0.1, or the one written at a blow-up) of
+<coupling>_tl_<resolution> for each coupling (interface-mirror: eqs 10-16 as printed) and draws fluid (coloured by speed),
 walls (black) and the gate (red) side by side. Needs the `vtk` Python module (python3-vtk9).
 """
 import glob
@@ -17,8 +18,9 @@ import vtk  # noqa: E402
 from vtk.util.numpy_support import vtk_to_numpy  # noqa: E402
 
 runs, res, png = sys.argv[1], sys.argv[2], sys.argv[3]
-couplings = ["stress", "interface", "repulsive"]
-fig, axes = plt.subplots(1, 3, figsize=(14, 4.2))
+couplings = ["stress", "interface-mirror", "interface", "repulsive"]  # interface-mirror: eqs 10-16 as printed
+fig, axes = plt.subplots(2, 2, figsize=(12, 6.4))
+axes = axes.ravel()
 for ax, coupling in zip(axes, couplings):
     files = sorted(glob.glob(os.path.join(runs, f"{coupling}_tl_{res}", "antoci_gate_*.vtu")))
     if not files:

@@ -7,13 +7,17 @@ set -uo pipefail
 exe=${1:-build/release/examples/antoci_gate}
 out=${2:-out/coupling}
 resolutions=${RESOLUTIONS:-"60 80 100"}
+couplings=${COUPLINGS:-"repulsive interface stress"}  # interface-mirror: eqs 10-16 as printed (--interface-form)
+solids=${SOLIDS:-"tl ul"}
 for res in $resolutions; do
-  for coupling in repulsive interface stress; do
-    for solid in tl ul; do
+  for coupling in $couplings; do
+    for solid in $solids; do
       dir="$out/${coupling}_${solid}_${res}"
       [ -f "$dir/summary.csv" ] && continue
       mkdir -p "$dir"
-      OMP_NUM_THREADS=2 OMP_WAIT_POLICY=passive "$exe" --coupling "$coupling" --solid "$solid" --resolution "$res" \
+      flags=(--coupling "$coupling")
+      [ "$coupling" = interface-mirror ] && flags=(--coupling interface --interface-form surface-mirror)
+      OMP_NUM_THREADS=2 OMP_WAIT_POLICY=passive "$exe" "${flags[@]}" --solid "$solid" --resolution "$res" \
         --snapshot-interval 0.1 --output "$dir" > "$dir/log.txt" 2>&1
       echo "$coupling $solid $res: exit $? $(grep -E 'RMS error' "$dir/log.txt")"
     done

@@ -197,6 +197,10 @@ int main(int argc, char** argv) try {
       cli.get_number("smoothing", opt.scene.smoothing_ratio, "smoothing length over spacing h / dp (fluid and gate)");
   const Scalar cli_normal_damping = cli.get_number(
       "normal-damping", 0, "repulsive coupling: beta of the normal dashpot, 0-1 (0: the paper's eqs 17-23)");
+  const std::string interface_form =
+      cli.get("interface-form", "integral",
+              "interface coupling: integral (eqs 3, 10-16 over every solid particle near the interface) | "
+              "surface-mirror (eqs 10-16 as printed: surface row, mirror-point reaction)");
   const std::string plane = cli.get(
       "plane", "strain", "2D gate: strain (plane strain, a wide plate) | stress (plane stress, free to contract)");
   opt.end_time = cli.get_number("end-time", 0.4, "simulated time, s");
@@ -220,6 +224,11 @@ int main(int argc, char** argv) try {
   if (plane != "strain" && plane != "stress")
     throw InputError(fmt::format("--plane = '{}' is invalid: valid values are strain, stress", plane));
   opt.scene.plane_stress = plane == "stress";
+  if (interface_form != "integral" && interface_form != "surface-mirror")
+    throw InputError(
+        fmt::format("--interface-form = '{}' is invalid: valid values are integral, surface-mirror", interface_form));
+  InterfacePressure<Scalar> interface;
+  interface.form = interface_form == "integral" ? InterfaceForm::integral : InterfaceForm::surface_mirror;
   // eps(z) of eq. 22 scales the repulsion with the depth below the still-water level, like hydrostatic pressure.
   RepulsiveForce<Scalar> repulsive;
   repulsive.water_level = opt.scene.column_height;
@@ -237,8 +246,7 @@ int main(int argc, char** argv) try {
     return tl ? run<TotalLagrangian>(opt, StressContinuity<Scalar>{})
               : run<UpdatedLagrangian>(opt, StressContinuity<Scalar>{});
   if (coupling == "interface")
-    return tl ? run<TotalLagrangian>(opt, InterfacePressure<Scalar>{})
-              : run<UpdatedLagrangian>(opt, InterfacePressure<Scalar>{});
+    return tl ? run<TotalLagrangian>(opt, interface) : run<UpdatedLagrangian>(opt, interface);
   if (coupling == "repulsive")
     return tl ? run<TotalLagrangian>(opt, repulsive) : run<UpdatedLagrangian>(opt, repulsive);
   throw InputError(

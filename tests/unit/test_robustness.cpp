@@ -269,6 +269,9 @@ TEST_CASE("Robustness: every bad input of the public API is rejected, naming the
   bad.expect("RepulsiveForce::range_factor", [] { RepulsiveForce<T>{.range_factor = 10}.validate(); });
   bad.expect("RepulsiveForce::strength", [] { RepulsiveForce<T>{.strength = 0}.validate(); });
   bad.expect("RepulsiveForce::normal_damping", [] { RepulsiveForce<T>{.normal_damping = -0.1}.validate(); });
+  bad.expect("InterfacePressure::min_shepard", [] { InterfacePressure<T>{.min_shepard = 0}.validate(); });
+  bad.expect("InterfacePressure::artificial_viscosity",
+             [] { InterfacePressure<T>{.artificial_viscosity = -0.1}.validate(); });
   bad.expect("RodSection::thickness", [] { RodSection<T>{.thickness = 0}.validate(); });
   bad.expect("RodSection::width", [] { RodSection<T>{.thickness = 1e-4, .width = -1}.validate(); });
   bad.expect("ElasticRodParameters::cfl", [] { ElasticRodParameters<T>{.cfl = 2}.validate(); });
@@ -302,7 +305,7 @@ TEST_CASE("Robustness: every bad input of the public API is rejected, naming the
   INFO(bad.report());
   CHECK(bad.failures.empty());
   CHECK(bad.rejected == bad.tried);
-  CHECK(bad.tried == 89 + 25 + 5);  // keeps the list from silently shrinking
+  CHECK(bad.tried == 89 + 25 + 5 + 2);  // keeps the list from silently shrinking
 }
 
 // ---------------------------------------------------------------------------------------------------------------
