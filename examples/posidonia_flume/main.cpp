@@ -138,7 +138,8 @@ scenes::PosidoniaFlume<T> converted(const scenes::PosidoniaFlume<double>& s) {
                   T(s.refinement.bunched_fraction),
                   s.refinement.shifting,
                   T(s.refinement.shift_coefficient),
-                  s.refinement.shift_passive};
+                  s.refinement.shift_passive,
+                  s.refinement.limit_fit};
   return c;
 }
 
@@ -757,6 +758,8 @@ int main(int argc, char** argv) try {
   s.refinement.shift_coefficient = cli.get_number("shift-coefficient", 2, "refinement: A of the particle shift");
   s.refinement.shift_passive =
       cli.get_switch("shift-passive", true, "refinement: shift the passive fine particles too: on | off");
+  s.refinement.limit_fit = cli.get_switch(
+      "limit-fit", false, "refinement: the passive particles' linear fit limited to its neighbours' range: on | off");
   o.local_steps = cli.get_switch("local-steps", false,
                                  "refinement: local time stepping, the coarse fluid at twice the fine step: on | off");
   o.uniform_viscosity = cli.get_switch(

@@ -106,6 +106,8 @@ int main(int argc, char** argv) try {
   const bool own_level = cli.get_switch(
       "own-level", true, "apr: passive particles interpolated from active ones of their own level too: on | off");
   const bool linear = cli.get_switch("linear", true, "apr: passive values by a linear MLS fit: on | off");
+  const bool limit_fit = cli.get_switch("limit-fit", false,
+                                        "apr: the linear fit limited to the range of its neighbours' values: on | off");
   const bool account = cli.get_switch("account", true, "apr: the mass account: on | off");
   const bool momentum_account = cli.get_switch("momentum-account", true, "apr: the momentum account: on | off");
   const bool volume_mass =
@@ -117,6 +119,10 @@ int main(int argc, char** argv) try {
       cli.get_number("shift-coefficient", 2, "apr: A of the shift -A h |v| dt grad C, (0, 10]");
   const bool shift_passive =
       cli.get_switch("shift-passive", false, "apr: shift the passive fine particles too: on | off");
+  const bool uniform_viscosity = cli.get_switch(
+      "uniform-viscosity", false,
+      "alpha applies at the base smoothing length and scales as h_base / h in the box, so the refined fluid has the "
+      "unrefined flume's viscosity (nu proportional to alpha h c0): on | off");
   if (!cli.finish()) return 0;
   if (method != "split" && method != "apr")
     throw InputError(fmt::format("--method = '{}' is invalid: valid values are split, apr", method));
@@ -142,6 +148,7 @@ int main(int argc, char** argv) try {
     scenes::add_fine_bed(system, g, x0 - margin, x1 + margin, 0.5 * dp);
   }
   fluid.artificial_viscosity = alpha;
+  if (uniform_viscosity) fluid.viscosity_reference_smoothing_length = g.smoothing_ratio * dp;  // the base level's h
   fluid.wall_artificial_viscosity = wall_viscosity;  // off: the flume's default (docs/flume.md)
   // split: the difference form at the jump (inert without resolution jumps); apr: no pair spans a jump.
   fluid.gradient_correction = apr ? GradientCorrection::none : GradientCorrection::resolution_jumps;
@@ -164,6 +171,7 @@ int main(int argc, char** argv) try {
   apr_params.bunched_fraction = bunched;
   apr_params.interpolate_from_own_level = own_level;
   apr_params.linear_interpolation = linear;
+  apr_params.limit_fit = limit_fit;
   apr_params.conserve_mass = account;
   apr_params.conserve_momentum = momentum_account;
   apr_params.passive_mass_from_volume = volume_mass;

@@ -20,7 +20,9 @@
 //   every level within their pair support (h_ab = (h_a + h_b) / 2; their own level's too, so that the stencil is
 //   two-sided at a box edge, where the other level is active on one side only) by the linear moving-least-squares
 //   fit, weights V_b W(r_ab, h_ab): f_a = c_0 of the least-squares fit f_b ~ c_0 + c . (x_b - x_a), exact for linear
-//   fields even where the stencil is one-sided (a free surface). Where the fit's moment matrix is degenerate, and
+//   fields even where the stencil is one-sided (a free surface); with limit_fit, held per component within the range
+//   of the values it is fitted from (Barth & Jespersen 1989's min-max principle: no overshoot where the fit
+//   extrapolates, still exact inside the stencil's hull). Where the fit's moment matrix is degenerate, and
 //   with linear_interpolation = false, the Shepard mean f_a = sum_b V_b f_b W_ab / sum_b V_b W_ab
 //   (interpolate_from_own_level = false: from the other levels only, the scheme of Chiron et al.; measured worse).
 //   and their mass is their SPH volume times their density, m_a = rho_a / sum_b W(r_ab, h_a) over the particles of
@@ -103,6 +105,11 @@ struct AdaptiveRefinementParameters {
   /// exact for linear fields, also where the stencil is one-sided (a free surface, a box edge); Shepard where the
   /// fit's moment matrix is degenerate.
   bool linear_interpolation{true};
+  /// Whether the linear fit is limited to the range of the values it is fitted from (per component, the smallest and
+  /// largest density and velocity of the accepted neighbours; Barth & Jespersen 1989's min-max principle): where the
+  /// stencil is one-sided (a free surface) the fit extrapolates and may overshoot; inside the neighbours' hull a linear
+  /// field lies within their range, so the limit leaves the fit exact there.
+  bool limit_fit{false};
   /// Whether a passive particle's mass is its SPH volume times its density (capped at the nominal mass), else the
   /// nominal mass rho0 s^Dim.
   bool passive_mass_from_volume{true};
@@ -500,6 +507,7 @@ class AdaptiveRefinement {
     Moment moment = Moment::Zero();
     Values rhs = Values::Zero();
     const T scale = T(1) / p.smoothing_length[a];
+    Column lowest = Column::Constant(std::numeric_limits<T>::infinity()), highest = -lowest;
     system.for_each_neighbor(a, [&](std::size_t b, const Vector& dx, T r, T h) {
       each(b, r);
       if (!accept(b)) return;
@@ -507,6 +515,10 @@ class AdaptiveRefinement {
       Column f;
       f[0] = p.density[b];
       f.template tail<Dim>() = p.velocity[b];
+      if (w > T(0)) {
+        lowest = lowest.cwiseMin(f);
+        highest = highest.cwiseMax(f);
+      }
       if (linear) {
         Column q;
         q[0] = T(1);
@@ -526,8 +538,10 @@ class AdaptiveRefinement {
       const Moment normalised = moment / weight;
       if (normalised.determinant() > T(1e-4)) {
         const Values c = normalised.ldlt().solve(rhs / weight);
-        p.density[a] = c(0, 0);
-        p.velocity[a] = c.row(0).template tail<Dim>().transpose();
+        Column value = c.row(0).transpose();
+        if (params_.limit_fit) value = value.cwiseMax(lowest).cwiseMin(highest);
+        p.density[a] = value[0];
+        p.velocity[a] = value.template tail<Dim>();
       }
     }
     p.pressure[a] = system.eos().pressure(p.density[a]);

@@ -76,6 +76,7 @@ struct PlantRefinement {
   bool shifting{false};         ///< particle shifting of the fine particles (AdaptiveRefinementParameters::shifting)
   T shift_coefficient{T(2)};    ///< A of the shift (fluid/particle_shifting.hpp), (0, 10]
   bool shift_passive{true};     ///< with shifting: the passive fine particles (transition zone) are shifted too
+  bool limit_fit{false};        ///< AdaptiveRefinementParameters::limit_fit (the passive fit within its data's range)
 };
 
 /// The Posidonia flume: waves, resolution, plants and blade model (lengths in m).
@@ -199,6 +200,7 @@ struct PosidoniaFlume {
     a.shifting.enabled = refinement.shifting;
     a.shifting.coefficient = refinement.shift_coefficient;
     a.shifting.include_passive = refinement.shift_passive;
+    a.limit_fit = refinement.limit_fit;
     return a;
   }
   /// The real blade as a line of rod nodes (rod, drag), not a continuum of particle rows (scaled, equivalent).
