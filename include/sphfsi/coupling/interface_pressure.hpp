@@ -66,15 +66,16 @@ struct InterfacePressure {
   }
 
  private:
-  /// p_int (12) at the interface point x_int of surface particle slot a, and sum_f V_f grad W(x_int - x_f) (11).
-  /// Returns false where the Shepard sum is below min_shepard (no fluid at the interface point).
+  /// p_int (12) at the interface point x_int of surface particle slot a and, if grad_sum is given, sum_f V_f
+  /// grad W(x_int - x_f) (11). Returns false where the Shepard sum is below min_shepard (no fluid at the point).
   template <class System, class Vector>
-  bool interface_pressure(const System& system, std::size_t a, const Vector& x_int, T& p_int, Vector& grad_sum) const {
+  bool interface_pressure(const System& system, std::size_t a, const Vector& x_int, T& p_int,
+                          Vector* grad_sum = nullptr) const {
     const auto& p = system.particles();
     const auto& kernel = system.kernel();
     const T support = static_cast<T>(System::kernel_type::support);
     T shepard = 0, pressure_sum = 0;
-    grad_sum = Vector::Zero();
+    if (grad_sum) *grad_sum = Vector::Zero();
     system.for_each_neighbor(a, [&](std::size_t f, const Vector&, T, T h) {
       if (p.kind[f] != Kind::fluid) return;
       const Vector dx = x_int - p.position[f];
@@ -84,7 +85,7 @@ struct InterfacePressure {
       const T w = V * kernel.value(r, h);
       shepard += w;
       pressure_sum += w * p.pressure[f];
-      grad_sum += V * kernel_gradient(kernel, dx, r, h);
+      if (grad_sum) *grad_sum += V * kernel_gradient(kernel, dx, r, h);
     });
     if (shepard < min_shepard) return false;
     p_int = pressure_sum / shepard;
@@ -115,8 +116,7 @@ struct InterfacePressure {
       const std::size_t s = p.slot_of_id(ids[k]);
       const Vector x_int = p.position[s] + T(0.5) * d * p.normal[s];  // (7), rl = 0
       T p_int = 0;
-      Vector unused;
-      if (!interface_pressure(system, s, x_int, p_int, unused)) continue;
+      if (!interface_pressure(system, s, x_int, p_int)) continue;
       system.for_each_neighbor(s, [&](std::size_t f, const Vector&, T, T) {
         if (p.kind[f] != Kind::fluid) return;
         const T r = (p.position[f] - x_int).squaredNorm();
@@ -144,9 +144,9 @@ struct InterfacePressure {
           const T c = T(0.5) * (p.sound_speed[f] + system.eos().reference_sound_speed());
           pair += (-artificial_viscosity * c * mu * p.density[f] * V_a * V_f) * grad;
         }
-        p.acceleration[a] -= pair / p.mass[a];  // (10-11, 13): pushes a away from f
-        p.acceleration[f] += pair / p.mass[f];  // (14-16): pushes f away from a
-        p.density_rate[f] -= p.density[f] * V_a * (p.velocity[f] - p.velocity[a]).dot(grad);  // (3)
+        p.acceleration[a] -= pair / p.mass[a];                     // (10-11, 13): pushes a away from f
+        p.acceleration[f] += pair / p.mass[f];                     // (14-16): pushes f away from a
+        p.density_rate[f] += p.density[f] * V_a * v_af.dot(grad);  // (3): rho_f V_a (v_f - v_a) . grad_f W
       });
     }
     for (const std::size_t f : touched) nearest[f] = infinity;
@@ -172,7 +172,7 @@ struct InterfacePressure {
       const Vector x_mirror = p.position[a] + d * n;        // mirror of a about the interface
       T p_int = 0;
       Vector grad_sum;
-      if (!interface_pressure(system, a, x_int, p_int, grad_sum)) continue;
+      if (!interface_pressure(system, a, x_int, p_int, &grad_sum)) continue;
       // Fluid particles around the mirror point: the neighbours of a.
       T reaction_norm = 0;
       fluid.clear();
