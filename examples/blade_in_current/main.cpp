@@ -16,6 +16,7 @@
 //
 // Writes <output>/summary.csv (one row per case), <output>/case_<Ca>.csv (drag and tip position vs time) and
 // <output>/effective_length.png (plot.py).
+#include <sphfsi/analysis/reconfiguration.hpp>
 #include <sphfsi/core/particle_system.hpp>
 #include <sphfsi/coupling/blade_drag.hpp>
 #include <sphfsi/coupling/coupled_body.hpp>
@@ -33,15 +34,18 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 using namespace sphfsi;
@@ -77,21 +81,42 @@ struct Options {
   T depth_lengths = 3;       // channel depth in blade lengths (blockage l / depth)
   T average_from = 3;        // the drag is averaged once the blade has moved this many lengths after the ramp
   std::vector<T> cauchy{0, 1, 3, 10, 30, 100, 300, 1000};  // 0: the rigid blade
+  // The force-law sweep: rigid blades inclined by these angles from the vertical (degrees, leaning downstream).
+  std::vector<T> inclinations;
+  // A force-law sweep's inclined.csv: the flexible sweep's summary then adds the static reconfiguration under
+  // that measured law (analysis/reconfiguration.hpp) beside Luhar & Nepf's.
+  std::filesystem::path force_law;
   std::filesystem::path output = "out/blade_in_current";
 };
 
 struct CaseResult {
   T target_ca, youngs_modulus, drag, drag_error, tip_x, tip_y, wall;
   std::size_t steps, particles;
+  T lift = 0, lift_error = 0;  // mean vertical force on the blade (up > 0), N/m, and its standard error
 };
 
-/// Luhar & Nepf (2011) effective length without buoyancy.
-T model_effective_length(T ca) {
-  return T(1) - (T(1) - T(0.9) * std::cbrt(T(1) / ca)) / (T(1) + T(8) * std::pow(ca, T(-1.5)));
+/// Mean of the samples and its standard error from 8 blocks (the samples are correlated within a block); NaN when
+/// there are fewer than 8 samples.
+std::pair<T, T> block_mean(const std::vector<T>& samples) {
+  const std::size_t blocks = 8, per = samples.size() / blocks;
+  if (per == 0) return {std::numeric_limits<T>::quiet_NaN(), std::numeric_limits<T>::quiet_NaN()};
+  T mean = 0;
+  for (T f : samples) mean += f;
+  mean /= T(samples.size());
+  T var = 0;
+  for (std::size_t b = 0; b < blocks; ++b) {
+    T m = 0;
+    for (std::size_t k = b * per; k < (b + 1) * per; ++k) m += samples[k];
+    m /= T(per);
+    var += (m - mean) * (m - mean);
+  }
+  return {mean, std::sqrt(var / T(blocks * (blocks - 1)))};
 }
 
+/// Runs one blade: flexible at the target Cauchy number, or rigid (target_ca = 0). `inclination`: the blade's rest
+/// angle from the vertical, leaning downstream (rad; the rigid blades of the force-law sweep).
 template <class Coupling>
-CaseResult run_case(const Options& o, T target_ca) {
+CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
   using Blade = CoupledBody<Coupling, Rod>;
   using Solver = Simulation<System, SymplecticVerlet, Blade>;
   constexpr bool porous = std::is_same_v<Coupling, BladeDrag<T>>;
@@ -102,6 +127,17 @@ CaseResult run_case(const Options& o, T target_ca) {
   const Resolution<T> res{dp, T(1.3)};
   System system(Domain<2, T>(V(-4 * dp, -4 * dp), V(tank + 4 * dp, depth + 4 * dp)), Tait<T>(rho, c0));
   add_fluid_block(system, V(0, 0), V(tank, depth), res, depth, T(0));
+  // The blade leans downstream of the towing (towards -x) by `inclination`. Upright, it lies on a lattice line with
+  // the fluid columns dp/2 on either side; inclined, the fluid within dp/2 of it is taken out.
+  const V direction(-std::sin(inclination), std::cos(inclination));
+  if (inclination != 0) {
+    auto& p = system.particles();
+    for (std::size_t k = p.size(); k-- > 0;) {
+      const V r = p.position[k] - V(x0, 0);
+      const T along = std::clamp(r.dot(direction), T(0), l);
+      if ((r - along * direction).norm() < dp / 2) p.remove(k);
+    }
+  }
   add_box_walls(system, V(0, 0), V(tank, depth), res, WallModel::dynamic);
   for_each_lattice_point<2, T>(V(-3 * dp, depth), V(tank + 3 * dp, depth + 3 * dp), dp, [&](const V& x) {
     system.particles().add(Kind::wall, x, V::Zero(), rho, rho * dp * dp, res.h(), 0);  // the lid
@@ -115,7 +151,7 @@ CaseResult run_case(const Options& o, T target_ca) {
   material.youngs_modulus =
       target_ca > 0 ? rho * o.nominal_drag * U * U * l * l * l / (2 * target_ca * second_moment) : T(1e9);
   const RodSection<T> section{.thickness = o.thickness, .width = T(0.01)};
-  add_elastic_rod(system, V(x0, 0), V(0, 1), l, nodes, material, section, res.h(), 1);
+  add_elastic_rod(system, V(x0, 0), direction, l, nodes, material, section, res.h(), 1);
   typename Rod::Parameters params;
   params.section = section;
   params.gravity = V::Zero();
@@ -160,10 +196,10 @@ CaseResult run_case(const Options& o, T target_ca) {
   sim.set_expected_flow_speed(2 * U);
 
   const std::string label = target_ca > 0 ? fmt::format("{:g}", target_ca) : "rigid";
-  io::CsvWriter csv(o.output / fmt::format("case_{}.csv", label), {"t", "drag", "tip_dx", "tip_dy"});
+  io::CsvWriter csv(o.output / fmt::format("case_{}.csv", label), {"t", "drag", "lift", "tip_dx", "tip_dy"});
   const T t_end = o.end_time > 0 ? o.end_time : ramp + tow / U, t_avg = ramp + o.average_from * l / U;
   const auto& ids = sim.template model<0>().solid().particle_ids();
-  std::vector<T> samples;
+  std::vector<T> samples, lift_samples;
   T tip_x = 0, tip_y = 0;
   std::size_t tip_n = 0;
   io::ProgressReporter progress(t_end);
@@ -182,11 +218,13 @@ CaseResult run_case(const Options& o, T target_ca) {
     if (s.time() < next_sample) return;
     next_sample += T(0.005);
     const auto& p = s.system().particles();
-    const T drag = -s.template model<0>().solid().coupling_force(p)[0];
+    const V force = s.template model<0>().solid().coupling_force(p);
+    const T drag = -force[0];
     const V base = p.position[p.slot_of_id(ids.front())], tip = p.position[p.slot_of_id(ids.back())];
-    csv.write_row({s.time(), drag, tip[0] - base[0], tip[1] - base[1]});
+    csv.write_row({s.time(), drag, force[1], tip[0] - base[0], tip[1] - base[1]});
     if (s.time() >= t_avg) {
       samples.push_back(drag);
+      lift_samples.push_back(force[1]);
       tip_x += tip[0] - base[0];
       tip_y += tip[1] - base[1];
       ++tip_n;
@@ -197,25 +235,64 @@ CaseResult run_case(const Options& o, T target_ca) {
   if constexpr (!porous)
     fmt::print("fluid particles that crossed the blade: {} (put back by the guard: {})\n", crossings.total(),
                sim.fluid().structure_crossings_prevented());
-  // Mean drag and its standard error from 8 blocks (the samples are correlated within a block).
-  const std::size_t blocks = 8, per = samples.size() / blocks;
-  if (per == 0) {  // a run shorter than the averaging window (--end-time): no drag average
-    const T nan = std::numeric_limits<T>::quiet_NaN();
-    return {target_ca, material.youngs_modulus, nan, nan, nan, nan, wall, sim.step_count(), system.size()};
+  const auto [mean, se] = block_mean(samples);
+  const auto [lift, lift_se] = block_mean(lift_samples);
+  return {target_ca, material.youngs_modulus, mean,          se,   tip_x / T(tip_n), tip_y / T(tip_n),
+          wall,      sim.step_count(),        system.size(), lift, lift_se};
+}
+
+/// The local force law of the resolved blade, measured on rigid blades inclined by theta from the vertical: per unit
+/// length, in units of (1/2) rho U^2 C_N(0) (the upright blade's normal load), the normal load (on the downstream
+/// face's normal) and the tangential load (along the blade, base to tip). The flexible blade at the same Ca, posed
+/// as Luhar & Nepf's static balance but with this law, is analysis::static_reconfiguration.
+int run_force_law_sweep(const Options& o) {
+  if (o.coupling != "repulsive")
+    throw InputError("--inclinations: the force law of the resolved blade needs --coupling repulsive");
+  if (o.inclinations.front() != 0) throw InputError("--inclinations must start with 0 (the upright blade)");
+  for (std::size_t k = 0; k < o.inclinations.size(); ++k) {
+    require_in_range("--inclinations (degrees)", o.inclinations[k], T(0), T(85));
+    if (k > 0 && !(o.inclinations[k] > o.inclinations[k - 1]))
+      throw InputError(fmt::format("--inclinations: {} is not above the angle before it", o.inclinations[k]));
   }
-  T mean = 0;
-  for (T f : samples) mean += f;
-  mean /= T(samples.size());
-  T var = 0;
-  for (std::size_t b = 0; b < blocks; ++b) {
-    T m = 0;
-    for (std::size_t k = b * per; k < (b + 1) * per; ++k) m += samples[k];
-    m /= T(per);
-    var += (m - mean) * (m - mean);
+  const T pi = std::numbers::pi_v<T>, rho = 1000, dynamic = T(0.5) * rho * o.speed * o.speed * o.length;
+  io::CsvWriter csv(o.output / "inclined.csv",
+                    {"inclination_deg", "drag", "drag_error", "lift", "lift_error", "normal_coefficient",
+                     "tangential_coefficient", "normal_load", "tangential_load", "steps", "wall_s"});
+  fmt::print(
+      "| inclination | drag F_x (N/m) | lift F_z (N/m) | C_N | C_T | C_N / C_N(0) | cos^2 | C_T / C_N(0) | wall (s) |\n"
+      "|---|---|---|---|---|---|---|---|---|\n");
+  T upright = 0;
+  for (const T degrees : o.inclinations) {
+    fmt::print("--- rigid blade inclined by {:g} degrees\n", degrees);
+    const T theta = degrees * pi / 180;
+    const CaseResult r = run_case<RepulsiveForce<T>>(o, 0, theta);
+    // Decomposed on the blade: n = (-cos, -sin) is the downstream face's normal (the blade leans towards -x, the
+    // water moves along -x relative to it), t = (-sin, cos) its tangent. drag = -F_x, lift = F_z.
+    const T normal = r.drag * std::cos(theta) - r.lift * std::sin(theta);
+    const T tangential = r.drag * std::sin(theta) + r.lift * std::cos(theta);
+    const T cn = normal / dynamic, ct = tangential / dynamic;
+    if (degrees == 0) upright = cn;
+    csv.write_row(
+        {degrees, r.drag, r.drag_error, r.lift, r.lift_error, cn, ct, cn / upright, ct / upright, T(r.steps), r.wall});
+    fmt::print("| {:g} | {:.4g} +- {:.2g} | {:.4g} +- {:.2g} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.0f} |\n",
+               degrees, r.drag, r.drag_error, r.lift, r.lift_error, cn, ct, cn / upright,
+               std::cos(theta) * std::cos(theta), ct / upright, r.wall);
   }
-  const T se = std::sqrt(var / T(blocks * (blocks - 1)));
-  return {target_ca, material.youngs_modulus, mean,         se, tip_x / T(tip_n), tip_y / T(tip_n),
-          wall,      sim.step_count(),        system.size()};
+  fmt::print("wrote {}\n", (o.output / "inclined.csv").string());
+  return 0;
+}
+
+/// The normal and tangential laws of a force-law sweep's inclined.csv: linear between the measured angles; beyond
+/// the last one, the normal load falls linearly to 0 at a blade lying flat (no normal velocity), the tangential load
+/// (skin friction) keeps its last value.
+std::pair<analysis::TabulatedLoad<T>, analysis::TabulatedLoad<T>> read_force_law(const std::filesystem::path& file) {
+  const auto table = io::read_csv(file);
+  std::vector<T> angle = table.column("inclination_deg");
+  for (T& a : angle) a *= std::numbers::pi_v<T> / 180;
+  const std::vector<T> normal = table.column("normal_load"), tangential = table.column("tangential_load");
+  if (angle.empty()) throw InputError(fmt::format("--force-law {}: no rows", file.string()));
+  return {analysis::TabulatedLoad<T>(angle, normal, T(0)),
+          analysis::TabulatedLoad<T>(angle, tangential, tangential.back())};
 }
 
 int main(int argc, char** argv) try {
@@ -256,6 +333,13 @@ int main(int argc, char** argv) try {
   o.depth_lengths = cli.get_number("depth", o.depth_lengths, "channel depth in blade lengths (blockage 1 / depth)");
   o.average_from = cli.get_number("average-from", o.average_from, "start of the drag average, blade lengths");
   const std::string list = cli.get("cauchy", "0,1,3,10,30,100,300,1000", "target Cauchy numbers (0: rigid blade)");
+  const std::string inclination_list =
+      cli.get("inclinations", "",
+              "force-law sweep instead of the Cauchy sweep: rigid blades inclined by these angles from the vertical, "
+              "degrees in [0, 85], leaning downstream, the first 0 (writes inclined.csv)");
+  o.force_law = cli.get("force-law", "",
+                        "inclined.csv of a force-law sweep: the static reconfiguration under that measured local law "
+                        "is added to the Cauchy sweep's summary (column model_2d)");
   o.output = cli.get("output", o.output.string(), "output folder");
   if (!cli.finish()) return 0;
   require_positive("--speed (m/s)", o.speed);
@@ -267,12 +351,21 @@ int main(int argc, char** argv) try {
   require_in_range("--rod-spacing (ds / dp)", o.rod_spacing, T(0.05), T(2));
   require_in_range("--depth (blade lengths)", o.depth_lengths, T(1.5), T(20));
   require_in_range("--average-from (blade lengths)", o.average_from, T(0), o.tow_lengths - T(1));
-  o.cauchy.clear();
-  std::stringstream ss(list);
-  for (std::string item; std::getline(ss, item, ',');) o.cauchy.push_back(std::stod(item));
+  const auto parse_list = [](const std::string& text) {
+    std::vector<T> values;
+    std::stringstream ss(text);
+    for (std::string item; std::getline(ss, item, ',');) values.push_back(std::stod(item));
+    return values;
+  };
+  o.cauchy = parse_list(list);
+  o.inclinations = parse_list(inclination_list);
+  std::filesystem::create_directories(o.output);
+  if (!o.inclinations.empty()) return run_force_law_sweep(o);
   if (o.cauchy.empty() || (o.end_time == 0 && o.cauchy.front() != 0))
     throw InputError("--cauchy must start with 0 (the rigid blade that every l_e / l is measured against)");
-  std::filesystem::create_directories(o.output);
+  // The measured local law, read before the runs so that a bad file stops at once.
+  std::optional<std::pair<analysis::TabulatedLoad<T>, analysis::TabulatedLoad<T>>> law;
+  if (!o.force_law.empty()) law = read_force_law(o.force_law);
 
   std::vector<CaseResult> results;
   for (const T ca : o.cauchy) {
@@ -298,23 +391,30 @@ int main(int argc, char** argv) try {
   const T drag_coefficient = rigid / (T(0.5) * rho * o.speed * o.speed * o.length);
   fmt::print("rigid blade: F = {:.4g} +- {:.2g} N/m, C_D = {:.3f} (blockage l / depth = {:.3g} included)\n", rigid,
              results.front().drag_error, drag_coefficient, 1 / o.depth_lengths);
-  io::CsvWriter summary(o.output / "summary.csv",
-                        {"target_ca", "ca", "youngs_modulus", "drag", "drag_error", "effective_length",
-                         "effective_length_error", "model", "tip_dx", "tip_dy", "steps", "particles", "wall_s"});
-  fmt::print("| Ca | E (Pa) | F (N/m) | l_e/l SPH | l_e/l model | deviation | tip (dx, dy)/l | wall (s) |\n");
-  fmt::print("|---|---|---|---|---|---|---|---|\n");
+  io::CsvWriter summary(o.output / "summary.csv", {"target_ca", "ca", "youngs_modulus", "drag", "drag_error",
+                                                   "effective_length", "effective_length_error", "model", "model_2d",
+                                                   "tip_dx", "tip_dy", "steps", "particles", "wall_s"});
+  fmt::print(
+      "| Ca | E (Pa) | F (N/m) | l_e/l SPH | l_e/l model | deviation | measured-law model (SPH's deviation) | tip (dx, "
+      "dy)/l | wall (s) |\n");
+  fmt::print("|---|---|---|---|---|---|---|---|---|\n");
   T worst = 0;
   for (const auto& r : results) {
     const T ca = r.target_ca > 0 ? r.target_ca * drag_coefficient / o.nominal_drag : 0;
     const T le = r.drag / rigid;
     const T le_err = le * std::hypot(r.drag_error / r.drag, results.front().drag_error / rigid);
-    const T model = ca > 0 ? model_effective_length(ca) : T(1);
+    const T model = ca > 0 ? analysis::luhar_nepf_effective_length_fit(ca) : T(1);
+    const T model_2d = !law     ? std::numeric_limits<T>::quiet_NaN()
+                       : ca > 0 ? analysis::static_reconfiguration(ca, law->first, law->second).effective_length
+                                : T(1);
     if (ca > 0) worst = std::max(worst, std::abs(le - model) / model);
-    summary.write_row({r.target_ca, ca, r.youngs_modulus, r.drag, r.drag_error, le, le_err, model, r.tip_x, r.tip_y,
-                       T(r.steps), T(r.particles), r.wall});
-    fmt::print("| {} | {:.3g} | {:.4g} | {:.3f} +- {:.3f} | {:.3f} | {:+.1f} % | ({:.2f}, {:.2f}) | {:.0f} |\n",
+    summary.write_row({r.target_ca, ca, r.youngs_modulus, r.drag, r.drag_error, le, le_err, model, model_2d, r.tip_x,
+                       r.tip_y, T(r.steps), T(r.particles), r.wall});
+    fmt::print("| {} | {:.3g} | {:.4g} | {:.3f} +- {:.3f} | {:.3f} | {:+.1f} % | {} | ({:.2f}, {:.2f}) | {:.0f} |\n",
                ca > 0 ? fmt::format("{:.3g}", ca) : std::string("rigid"), r.youngs_modulus, r.drag, le, le_err, model,
-               ca > 0 ? 100 * (le - model) / model : 0.0, r.tip_x / o.length, r.tip_y / o.length, r.wall);
+               ca > 0 ? 100 * (le - model) / model : 0.0,
+               law ? fmt::format("{:.3f} ({:+.1f} %)", model_2d, 100 * (le - model_2d) / model_2d) : std::string("-"),
+               r.tip_x / o.length, r.tip_y / o.length, r.wall);
   }
   fmt::print("largest deviation from Luhar & Nepf: {:.1f} % ({} particles, dp = {:.3g} m)\n", 100 * worst,
              results.front().particles, o.length / o.particles_along);

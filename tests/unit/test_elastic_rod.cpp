@@ -2,6 +2,7 @@
 // under a large tip load, the first bending frequency against Euler-Bernoulli, energy, momentum, rigid motions,
 // sub-cycling with the external force held over the outer step, blade normals and checkpointing.
 #include <sphfsi/analysis/elastica.hpp>
+#include <sphfsi/analysis/reconfiguration.hpp>
 #include <sphfsi/core/particle_system.hpp>
 #include <sphfsi/eos/linear.hpp>
 #include <sphfsi/io/checkpoint.hpp>
@@ -396,4 +397,110 @@ TEST_CASE("elastic rod: a contact plane stops a blade folding onto the bed", "[r
   CHECK(lowest >= gap - 1e-12);
   CHECK(lowest <= gap + 1e-3);  // the blade does rest on the bed
   CHECK_THROWS_WITH(rod.set_contact_plane(V(0, 0), V(0, 0), gap), Catch::Contains("set_contact_plane |normal|"));
+}
+
+TEST_CASE("elastic rod: nodes added after other particles were removed (ids above the particle count)", "[rod]") {
+  // A scene that takes fluid out before adding its blade (an inclined blade cut into a fluid block) leaves ids
+  // above the particle count. The rod indexes its nodes by id: it must size that index by the id capacity, not by
+  // the particle count (a heap overflow before, found by blade_in_current --inclinations).
+  System system = make_system();
+  auto& p = system.particles();
+  for (int k = 0; k < 50; ++k) p.add(sphfsi::Kind::fluid, V(-0.5 + 0.01 * k, 0.5), V::Zero(), 1000, 0.1, 0.013);
+  for (std::size_t k = p.size(); k-- > 5;) p.remove(k);
+  sphfsi::add_elastic_rod(system, V(0, 0), V(1, 0), L, 11, blade, section, L / 10, 0);
+  REQUIRE(p.size() == 16);
+  REQUIRE(p.id_capacity() == 61);
+  Rod rod(system, 0, blade, weightless());
+  rod.clamp_base();
+  CHECK(rod.particle_ids().size() == 11);
+  CHECK(rod.particle_ids().back() == 60);
+  CHECK(rod.tip_position()[0] == Approx(L).epsilon(1e-12));
+  rod.advance(system, 0, rod.solid_time_step());  // reads and writes every node by its id
+  CHECK(rod.tip_position()[0] == Approx(L).epsilon(1e-12));
+}
+
+TEST_CASE("reconfiguration: the static blade in a current, small-load limit and bad input", "[rod][reconfiguration]") {
+  using sphfsi::analysis::luhar_nepf_reconfiguration;
+  // Small Ca: the linear cantilever under a uniform load q: tip slope q l^3 / (6 EI) = Ca / 6, tip deflection Ca / 8,
+  // l_e / l = 1 - O(Ca^2) (the load falls as cos^2 and its horizontal part as cos^3). Relative corrections O(Ca^2).
+  const auto small = luhar_nepf_reconfiguration(1e-3);
+  CHECK(small.tip_angle == Approx(1e-3 / 6).epsilon(1e-5));
+  CHECK(small.tip_x == Approx(1e-3 / 8).epsilon(1e-5));
+  CHECK(small.tip_z == Approx(1).epsilon(1e-5));
+  CHECK(small.effective_length == Approx(1).epsilon(1e-5));
+  // Rigid limit and large Ca: l_e falls as Ca^(-1/3) (Luhar & Nepf 2011's scaling): l_e Ca^(1/3) settles.
+  CHECK(luhar_nepf_reconfiguration(0.0).effective_length == Approx(1).epsilon(1e-12));
+  const double c4 = luhar_nepf_reconfiguration(1e4, 8000).effective_length * std::cbrt(1e4);
+  const double c5 = luhar_nepf_reconfiguration(1e5, 8000).effective_length * std::cbrt(1e5);
+  CHECK(std::abs(c5 / c4 - 1) < 0.01);
+  // The tabulated law of cos^2 at 10-degree steps reproduces the exact law to the interpolation error (< 1 %).
+  std::vector<double> angle, value;
+  for (int d = 0; d < 90; d += 10) {
+    angle.push_back(d * std::numbers::pi / 180);
+    value.push_back(std::cos(angle.back()) * std::cos(angle.back()));
+  }
+  const sphfsi::analysis::TabulatedLoad<double> tabulated(angle, value, 0.0);
+  for (double ca : {1.0, 30.0, 1000.0}) {
+    const double exact = luhar_nepf_reconfiguration(ca).effective_length;
+    const double table =
+        sphfsi::analysis::static_reconfiguration(ca, tabulated, [](double) { return 0.0; }).effective_length;
+    CHECK(std::abs(table / exact - 1) < 0.01);
+  }
+  CHECK_THROWS_WITH(luhar_nepf_reconfiguration(-1.0), Catch::Contains("Cauchy number"));
+  CHECK_THROWS_WITH(sphfsi::analysis::static_reconfiguration(
+                        1.0, [](double) { return 0.0; }, [](double) { return 0.0; }),
+                    Catch::Contains("normal_load(0)"));
+  CHECK_THROWS_WITH(sphfsi::analysis::TabulatedLoad<double>({0.0, 0.5, 0.4}, {1, 1, 1}, 0.0),
+                    Catch::Contains("not above"));
+  CHECK_THROWS_WITH(sphfsi::analysis::TabulatedLoad<double>({0.1}, {1}, 0.0), Catch::Contains("first angle must be 0"));
+  CHECK_THROWS_WITH(sphfsi::analysis::TabulatedLoad<double>({0.0, 1.6}, {1, 1}, 0.0), Catch::Contains("pi/2"));
+}
+
+TEST_CASE("reconfiguration: the shooting solution equals the discrete rod relaxed under the same local load",
+          "[rod][reconfiguration]") {
+  // Two independent discretisations of the same static problem: the ODE shot from the tip
+  // (analysis/reconfiguration.hpp, RK4) and the discrete elastic rod with 40 edges relaxed dynamically under the local
+  // load, evaluated at every node from its own tangent (follower load, trapezoidal in s). They agree to the rod's
+  // O(1/n^2) = 6e-4 (observed order 2 in the static tables of docs/thin-blades.md): bound 2e-3 on l_e / l and on the
+  // tip position over l. The law is Luhar & Nepf's cos^2 plus a skin friction of 0.05 of the upright normal load, so
+  // both load directions are used.
+  const auto normal = [](double th) { return std::cos(th) * std::cos(th); };
+  const auto tangential = [](double th) { return 0.05 * std::sin(th); };
+  for (const double ca : {3.0, 30.0}) {
+    const int edges = 40;
+    System system = make_system();
+    sphfsi::add_elastic_rod(system, V(0, 0), V(0, 1), L, edges + 1, blade, section, L / edges, 0);
+    Rod rod(system, 0, blade, weightless(2 * omega1));
+    rod.clamp_base();
+    auto& p = system.particles();
+    const auto& ids = rod.particle_ids();
+    const double q = ca * EI / (L * L * L);  // the upright blade's load per unit length, N/m
+    const double ds = L / edges, dt = 20 * rod.solid_time_step();
+    double t = 0, load_x = 0;
+    for (int step = 0; step < 200000; ++step) {
+      load_x = 0;
+      for (std::size_t i = 0; i < ids.size(); ++i) {
+        const auto x = [&](std::size_t k) { return p.position[p.slot_of_id(ids[k])]; };
+        const V tangent = (i == 0                ? x(1) - x(0)
+                           : i + 1 == ids.size() ? x(i) - x(i - 1)
+                                                 : x(i + 1) - x(i - 1))
+                              .normalized();
+        const double th = std::atan2(tangent[0], tangent[1]);
+        const V force = q * (i == 0 || i + 1 == ids.size() ? ds / 2 : ds) *
+                        (normal(th) * V(tangent[1], -tangent[0]) + tangential(th) * tangent);
+        p.acceleration[p.slot_of_id(ids[i])] = force / rod.node_masses()[i];
+        load_x += force[0];
+      }
+      rod.advance(system, t, dt);
+      t += dt;
+      double v_max = 0;
+      for (const auto& v : rod.velocities()) v_max = std::max(v_max, v.norm());
+      if (step > 100 && v_max < 1e-10 * L * omega1) break;
+    }
+    const auto shot = sphfsi::analysis::static_reconfiguration(ca, normal, tangential);
+    INFO("Ca = " << ca << ": rod l_e / l = " << load_x / (q * L) << ", shooting " << shot.effective_length);
+    CHECK(std::abs(load_x / (q * L) - shot.effective_length) < 1e-3);
+    CHECK(std::abs(rod.tip_position()[0] / L - shot.tip_x) < 1e-3);
+    CHECK(std::abs(rod.tip_position()[1] / L - shot.tip_z) < 1e-3);
+  }
 }

@@ -177,3 +177,26 @@ TEST_CASE("Checkpoint: a solid checkpoint read into another scene gives a clear 
     CHECK_THROWS_WITH(io::read_checkpoint(file, sim), Catch::Contains("solid body 1 was saved with"));
   }
 }
+
+TEST_CASE("solid body: particles added after others were removed (ids above the particle count)", "[solid]") {
+  // The solid models index their particles by id (solid/body.hpp): the index must span the id capacity, not the
+  // particle count, once particles were removed before the solid was built.
+  System system(Domain<2, double>(V(-0.1, -0.1), V(0.3, 0.3)), Tait<double>(1000, 20));
+  const Resolution<double> res{0.005, 1.3};
+  add_fluid_block(system, V(0, 0), V(0.05, 0.06), res, 0.06, 9.81);
+  auto& p = system.particles();
+  for (std::size_t k = p.size(); k-- > 10;) p.remove(k);
+  add_solid_block(system, V(0.05, 0), V(0.065, 0.08), res, rubber(), 1);
+  REQUIRE(p.id_capacity() > p.size());
+  TotalLagrangianParameters<2, double> params;
+  TotalLagrangianSolid<System> solid = make_solid(system, params);
+  std::size_t solids = 0;
+  for (std::size_t k = 0; k < p.size(); ++k) solids += p.kind[k] == Kind::solid ? 1 : 0;
+  CHECK(solid.particle_ids().size() == solids);
+  CHECK(solid.body_data().local_index(p.id[p.size() - 1]) == static_cast<std::int64_t>(solids - 1));
+  // Undeformed: identity deformation gradient at the particle with the largest id, and one step leaves it there.
+  CHECK((solid.deformation_gradient(p.id[p.size() - 1]) - Eigen::Matrix2d::Identity()).norm() < 1e-12);
+  solid.compute_rates(system, 0);
+  solid.advance(system, 0, solid.solid_time_step());
+  CHECK(solid.max_stretch() == Approx(1).margin(1e-9));
+}

@@ -45,7 +45,7 @@ class SolidBody {
                       "before creating its solid model",
                       body, body));
     std::sort(ids_.begin(), ids_.end());
-    local_of_id_.assign(p.size(), -1);
+    local_of_id_.assign(p.id_capacity(), -1);  // indexed by id: ids of removed particles stay unused
     const std::size_t n = ids_.size();
     reference_position_.resize(n);
     volume_.resize(n);

@@ -165,7 +165,7 @@ class ElasticRod {
           fmt::format("ElasticRod: body {} has {} nodes: valid range is [3, inf) (add the nodes with "
                       "add_elastic_rod before creating the model)",
                       body, n));
-    local_of_id_.assign(p.size(), -1);
+    local_of_id_.assign(p.id_capacity(), -1);  // indexed by id: ids of removed particles stay unused
     x_.resize(n);
     v_.resize(n);
     for (std::size_t k = 0; k < n; ++k) {
