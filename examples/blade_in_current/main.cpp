@@ -83,6 +83,7 @@ struct Options {
   std::vector<T> cauchy{0, 1, 3, 10, 30, 100, 300, 1000};  // 0: the rigid blade
   // The force-law sweep: rigid blades inclined by these angles from the vertical (degrees, leaning downstream).
   std::vector<T> inclinations;
+  T mount_height = 0;  // force-law sweep: the rigid blades' base above the bed, blade lengths (0: on the bed)
   // A force-law sweep's inclined.csv: the flexible sweep's summary then adds the static reconfiguration under
   // that measured law (analysis/reconfiguration.hpp) beside Luhar & Nepf's.
   std::filesystem::path force_law;
@@ -93,6 +94,7 @@ struct CaseResult {
   T target_ca, youngs_modulus, drag, drag_error, tip_x, tip_y, wall;
   std::size_t steps, particles;
   T lift = 0, lift_error = 0;  // mean vertical force on the blade (up > 0), N/m, and its standard error
+  T tip_height_rms = 0;        // standard deviation of the tip's height over the averaging window, m (flutter)
 };
 
 /// Mean of the samples and its standard error from 8 blocks (the samples are correlated within a block); NaN when
@@ -130,10 +132,11 @@ CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
   // The blade leans downstream of the towing (towards -x) by `inclination`. Upright, it lies on a lattice line with
   // the fluid columns dp/2 on either side; inclined, the fluid within dp/2 of it is taken out.
   const V direction(-std::sin(inclination), std::cos(inclination));
+  const V base(x0, target_ca > 0 ? T(0) : std::round(o.mount_height * l / dp) * dp);
   if (inclination != 0) {
     auto& p = system.particles();
     for (std::size_t k = p.size(); k-- > 0;) {
-      const V r = p.position[k] - V(x0, 0);
+      const V r = p.position[k] - base;
       const T along = std::clamp(r.dot(direction), T(0), l);
       if ((r - along * direction).norm() < dp / 2) p.remove(k);
     }
@@ -151,7 +154,7 @@ CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
   material.youngs_modulus =
       target_ca > 0 ? rho * o.nominal_drag * U * U * l * l * l / (2 * target_ca * second_moment) : T(1e9);
   const RodSection<T> section{.thickness = o.thickness, .width = T(0.01)};
-  add_elastic_rod(system, V(x0, 0), direction, l, nodes, material, section, res.h(), 1);
+  add_elastic_rod(system, base, direction, l, nodes, material, section, res.h(), 1);
   typename Rod::Parameters params;
   params.section = section;
   params.gravity = V::Zero();
@@ -200,7 +203,7 @@ CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
   const T t_end = o.end_time > 0 ? o.end_time : ramp + tow / U, t_avg = ramp + o.average_from * l / U;
   const auto& ids = sim.template model<0>().solid().particle_ids();
   std::vector<T> samples, lift_samples;
-  T tip_x = 0, tip_y = 0;
+  T tip_x = 0, tip_y = 0, tip_y_squared = 0;
   std::size_t tip_n = 0;
   io::ProgressReporter progress(t_end);
   const auto start = std::chrono::steady_clock::now();
@@ -227,6 +230,7 @@ CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
       lift_samples.push_back(force[1]);
       tip_x += tip[0] - base[0];
       tip_y += tip[1] - base[1];
+      tip_y_squared += (tip[1] - base[1]) * (tip[1] - base[1]);
       ++tip_n;
     }
   });
@@ -237,8 +241,13 @@ CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
                sim.fluid().structure_crossings_prevented());
   const auto [mean, se] = block_mean(samples);
   const auto [lift, lift_se] = block_mean(lift_samples);
-  return {target_ca, material.youngs_modulus, mean,          se,   tip_x / T(tip_n), tip_y / T(tip_n),
-          wall,      sim.step_count(),        system.size(), lift, lift_se};
+  const T n = T(tip_n), height = tip_y / n;
+  return {target_ca,     material.youngs_modulus,
+          mean,          se,
+          tip_x / n,     height,
+          wall,          sim.step_count(),
+          system.size(), lift,
+          lift_se,       std::sqrt(std::max(tip_y_squared / n - height * height, T(0)))};
 }
 
 /// The local force law of the resolved blade, measured on rigid blades inclined by theta from the vertical: per unit
@@ -249,6 +258,7 @@ int run_force_law_sweep(const Options& o) {
   if (o.coupling != "repulsive")
     throw InputError("--inclinations: the force law of the resolved blade needs --coupling repulsive");
   if (o.inclinations.front() != 0) throw InputError("--inclinations must start with 0 (the upright blade)");
+  require_in_range("--mount-height (blade lengths)", o.mount_height, T(0), o.depth_lengths - T(1.5));
   for (std::size_t k = 0; k < o.inclinations.size(); ++k) {
     require_in_range("--inclinations (degrees)", o.inclinations[k], T(0), T(85));
     if (k > 0 && !(o.inclinations[k] > o.inclinations[k - 1]))
@@ -337,6 +347,9 @@ int main(int argc, char** argv) try {
       cli.get("inclinations", "",
               "force-law sweep instead of the Cauchy sweep: rigid blades inclined by these angles from the vertical, "
               "degrees in [0, 85], leaning downstream, the first 0 (writes inclined.csv)");
+  o.mount_height = cli.get_number("mount-height", 0,
+                                  "force-law sweep: the rigid blades' base above the bed, blade lengths (0: on the "
+                                  "bed; > 0: a plate in open water, away from the bed)");
   o.force_law = cli.get("force-law", "",
                         "inclined.csv of a force-law sweep: the static reconfiguration under that measured local law "
                         "is added to the Cauchy sweep's summary (column model_2d)");
@@ -376,7 +389,7 @@ int main(int argc, char** argv) try {
       if (ca == 0) throw;             // without the rigid reference there is nothing to compare with
       fmt::print(stderr, "Ca = {:g}: run stopped: {}\n", ca, e.what());
       const T nan = std::numeric_limits<T>::quiet_NaN();
-      results.push_back({ca, nan, nan, nan, nan, nan, 0, 0, 0});
+      results.push_back({ca, nan, nan, nan, nan, nan, 0, 0, 0, nan, nan, nan});
     }
   }
   if (o.end_time > 0) {  // a short run (the sub-cycling comparison): cost only, the records are in case_*.csv
@@ -395,26 +408,29 @@ int main(int argc, char** argv) try {
                                                    "effective_length", "effective_length_error", "model", "model_2d",
                                                    "tip_dx", "tip_dy", "steps", "particles", "wall_s"});
   fmt::print(
-      "| Ca | E (Pa) | F (N/m) | l_e/l SPH | l_e/l model | deviation | measured-law model (SPH's deviation) | tip (dx, "
-      "dy)/l | wall (s) |\n");
-  fmt::print("|---|---|---|---|---|---|---|---|---|\n");
+      "| Ca | E (Pa) | F (N/m) | l_e/l SPH | l_e/l model (fit) | deviation | static model | measured-law model (SPH's "
+      "deviation) | tip (dx, dy)/l | tip height rms / l | wall (s) |\n");
+  fmt::print("|---|---|---|---|---|---|---|---|---|---|---|\n");
   T worst = 0;
   for (const auto& r : results) {
     const T ca = r.target_ca > 0 ? r.target_ca * drag_coefficient / o.nominal_drag : 0;
     const T le = r.drag / rigid;
     const T le_err = le * std::hypot(r.drag_error / r.drag, results.front().drag_error / rigid);
     const T model = ca > 0 ? analysis::luhar_nepf_effective_length_fit(ca) : T(1);
+    const T model_static = ca > 0 ? analysis::luhar_nepf_reconfiguration(ca).effective_length : T(1);
     const T model_2d = !law     ? std::numeric_limits<T>::quiet_NaN()
                        : ca > 0 ? analysis::static_reconfiguration(ca, law->first, law->second).effective_length
                                 : T(1);
     if (ca > 0) worst = std::max(worst, std::abs(le - model) / model);
-    summary.write_row({r.target_ca, ca, r.youngs_modulus, r.drag, r.drag_error, le, le_err, model, model_2d, r.tip_x,
-                       r.tip_y, T(r.steps), T(r.particles), r.wall});
-    fmt::print("| {} | {:.3g} | {:.4g} | {:.3f} +- {:.3f} | {:.3f} | {:+.1f} % | {} | ({:.2f}, {:.2f}) | {:.0f} |\n",
-               ca > 0 ? fmt::format("{:.3g}", ca) : std::string("rigid"), r.youngs_modulus, r.drag, le, le_err, model,
-               ca > 0 ? 100 * (le - model) / model : 0.0,
-               law ? fmt::format("{:.3f} ({:+.1f} %)", model_2d, 100 * (le - model_2d) / model_2d) : std::string("-"),
-               r.tip_x / o.length, r.tip_y / o.length, r.wall);
+    summary.write_row({r.target_ca, ca, r.youngs_modulus, r.drag, r.drag_error, le, le_err, model, model_static,
+                       model_2d, r.tip_x, r.tip_y, r.tip_height_rms, T(r.steps), T(r.particles), r.wall});
+    fmt::print(
+        "| {} | {:.3g} | {:.4g} | {:.3f} +- {:.3f} | {:.3f} | {:+.1f} % | {:.3f} | {} | ({:.2f}, {:.2f}) | {:.2f} | "
+        "{:.0f} |\n",
+        ca > 0 ? fmt::format("{:.3g}", ca) : std::string("rigid"), r.youngs_modulus, r.drag, le, le_err, model,
+        ca > 0 ? 100 * (le - model) / model : 0.0, model_static,
+        law ? fmt::format("{:.3f} ({:+.1f} %)", model_2d, 100 * (le - model_2d) / model_2d) : std::string("-"),
+        r.tip_x / o.length, r.tip_y / o.length, r.tip_height_rms / o.length, r.wall);
   }
   fmt::print("largest deviation from Luhar & Nepf: {:.1f} % ({} particles, dp = {:.3g} m)\n", 100 * worst,
              results.front().particles, o.length / o.particles_along);
