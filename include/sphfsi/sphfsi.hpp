@@ -4,6 +4,8 @@
 
 #include <sphfsi/analysis/elastica.hpp>
 #include <sphfsi/analysis/line_fit.hpp>
+#include <sphfsi/analysis/reconfiguration.hpp>
+#include <sphfsi/analysis/runge_kutta.hpp>
 #include <sphfsi/analysis/vegetation_drag.hpp>
 #include <sphfsi/analysis/wave_reflection.hpp>
 #include <sphfsi/analysis/zero_crossing.hpp>

@@ -9,6 +9,7 @@
 // integrated by classical RK4 with 4000 steps (error about 1e-12).
 #pragma once
 
+#include <sphfsi/analysis/runge_kutta.hpp>
 #include <sphfsi/core/error.hpp>
 #include <sphfsi/core/types.hpp>
 
@@ -29,17 +30,7 @@ std::pair<T, T> elastica_tip_load(T alpha) {
     };
     constexpr int steps = 4000;
     const T h = T(1) / steps;
-    for (int i = 0; i < steps; ++i) {
-      const auto k1 = rate(y);
-      std::array<T, 4> y2, y3, y4;
-      for (int c = 0; c < 4; ++c) y2[c] = y[c] + T(0.5) * h * k1[c];
-      const auto k2 = rate(y2);
-      for (int c = 0; c < 4; ++c) y3[c] = y[c] + T(0.5) * h * k2[c];
-      const auto k3 = rate(y3);
-      for (int c = 0; c < 4; ++c) y4[c] = y[c] + h * k3[c];
-      const auto k4 = rate(y4);
-      for (int c = 0; c < 4; ++c) y[c] += h / 6 * (k1[c] + 2 * k2[c] + 2 * k3[c] + k4[c]);
-    }
+    for (int i = 0; i < steps; ++i) runge_kutta4_step(y, h, rate);
     return y;
   };
   T lo = 0, hi = alpha;

@@ -17,6 +17,7 @@
 // horizontal force over the upright rigid blade's: l_e / l = G_x(0) / normal_load(0).
 #pragma once
 
+#include <sphfsi/analysis/runge_kutta.hpp>
 #include <sphfsi/core/error.hpp>
 #include <sphfsi/core/types.hpp>
 
@@ -59,17 +60,7 @@ Reconfiguration<T> static_reconfiguration(T cauchy, NormalLoad&& normal_load, Ta
   const auto shoot = [&](T tip_angle) {
     State y{tip_angle, T(0), T(0), T(0), T(0), T(0)};
     const T h = T(-1) / T(steps);  // from the tip (s = 1) to the clamp (s = 0)
-    for (int i = 0; i < steps; ++i) {
-      const State k1 = rate(y);
-      State y2, y3, y4;
-      for (int c = 0; c < 6; ++c) y2[c] = y[c] + T(0.5) * h * k1[c];
-      const State k2 = rate(y2);
-      for (int c = 0; c < 6; ++c) y3[c] = y[c] + T(0.5) * h * k2[c];
-      const State k3 = rate(y3);
-      for (int c = 0; c < 6; ++c) y4[c] = y[c] + h * k3[c];
-      const State k4 = rate(y4);
-      for (int c = 0; c < 6; ++c) y[c] += h / 6 * (k1[c] + 2 * k2[c] + 2 * k3[c] + k4[c]);
-    }
+    for (int i = 0; i < steps; ++i) runge_kutta4_step(y, h, rate);
     return y;
   };
   T lo = 0, hi = std::numbers::pi_v<T> / 2;
