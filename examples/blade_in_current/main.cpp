@@ -404,9 +404,10 @@ int main(int argc, char** argv) try {
   const T drag_coefficient = rigid / (T(0.5) * rho * o.speed * o.speed * o.length);
   fmt::print("rigid blade: F = {:.4g} +- {:.2g} N/m, C_D = {:.3f} (blockage l / depth = {:.3g} included)\n", rigid,
              results.front().drag_error, drag_coefficient, 1 / o.depth_lengths);
-  io::CsvWriter summary(o.output / "summary.csv", {"target_ca", "ca", "youngs_modulus", "drag", "drag_error",
-                                                   "effective_length", "effective_length_error", "model", "model_2d",
-                                                   "tip_dx", "tip_dy", "steps", "particles", "wall_s"});
+  io::CsvWriter summary(
+      o.output / "summary.csv",
+      {"target_ca", "ca", "youngs_modulus", "drag", "drag_error", "effective_length", "effective_length_error", "model",
+       "model_static", "model_2d", "tip_dx", "tip_dy", "tip_dy_rms", "steps", "particles", "wall_s"});
   fmt::print(
       "| Ca | E (Pa) | F (N/m) | l_e/l SPH | l_e/l model (fit) | deviation | static model | measured-law model (SPH's "
       "deviation) | tip (dx, dy)/l | tip height rms / l | wall (s) |\n");
