@@ -132,11 +132,11 @@ CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
   // The blade leans downstream of the towing (towards -x) by `inclination`. Upright, it lies on a lattice line with
   // the fluid columns dp/2 on either side; inclined, the fluid within dp/2 of it is taken out.
   const V direction(-std::sin(inclination), std::cos(inclination));
-  const V base(x0, target_ca > 0 ? T(0) : std::round(o.mount_height * l / dp) * dp);
+  const V mount(x0, target_ca > 0 ? T(0) : std::round(o.mount_height * l / dp) * dp);  // the blade's base
   if (inclination != 0) {
     auto& p = system.particles();
     for (std::size_t k = p.size(); k-- > 0;) {
-      const V r = p.position[k] - base;
+      const V r = p.position[k] - mount;
       const T along = std::clamp(r.dot(direction), T(0), l);
       if ((r - along * direction).norm() < dp / 2) p.remove(k);
     }
@@ -154,7 +154,7 @@ CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
   material.youngs_modulus =
       target_ca > 0 ? rho * o.nominal_drag * U * U * l * l * l / (2 * target_ca * second_moment) : T(1e9);
   const RodSection<T> section{.thickness = o.thickness, .width = T(0.01)};
-  add_elastic_rod(system, base, direction, l, nodes, material, section, res.h(), 1);
+  add_elastic_rod(system, mount, direction, l, nodes, material, section, res.h(), 1);
   typename Rod::Parameters params;
   params.section = section;
   params.gravity = V::Zero();
