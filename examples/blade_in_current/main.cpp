@@ -76,10 +76,15 @@ struct Options {
   // drag coupling: share phi of the 2D channel's width the blade covers (b / W of one blade in a flume of width W;
   // 1: a full-width row of blades, whose drag slows the whole 2D stream through it; coupling/blade_drag.hpp)
   T frontal_fraction = 1;
-  bool global_step = false;  // true: the fluid steps with the rod's own stable step (no sub-cycling)
-  T end_time = 0;            // s; 0: the ramp and the whole towing distance
-  T depth_lengths = 3;       // channel depth in blade lengths (blockage l / depth)
-  T average_from = 3;        // the drag is averaged once the blade has moved this many lengths after the ramp
+  bool global_step = false;          // true: the fluid steps with the rod's own stable step (no sub-cycling)
+  T end_time = 0;                    // s; 0: the ramp and the whole towing distance
+  T sound_speed = 20;                // c0 / U, the fluid's artificial sound speed over the towing speed
+  T artificial_viscosity = T(0.02);  // alpha: nu = alpha h c0 / 8 (Re = U l / nu = 230 at the defaults)
+  // Background pressure over rho U^2 (0: none). The resolved blade's repulsive faces can only push: without an ambient
+  // pressure the wake's suction pulls the fluid off the lee face (g = 0: no hydrostatic pressure, unlike the flume).
+  T background_pressure = 0;
+  T depth_lengths = 3;  // channel depth in blade lengths (blockage l / depth)
+  T average_from = 3;   // the drag is averaged once the blade has moved this many lengths after the ramp
   std::vector<T> cauchy{0, 1, 3, 10, 30, 100, 300, 1000};  // 0: the rigid blade
   // The force-law sweep: rigid blades inclined by these angles from the vertical (degrees, leaning downstream).
   std::vector<T> inclinations;
@@ -125,7 +130,7 @@ CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
   const T l = o.length, dp = l / o.particles_along, depth = o.depth_lengths * l, U = o.speed, rho = 1000;
   const T x0 = 2 * l, ramp = T(0.25), tow = o.tow_lengths * l;
   const T tank = x0 + U * ramp / 2 + tow + 3 * l;
-  const T c0 = 20 * U;  // the flow around the blade's tip reaches about 2 U: c0 >= 10 x that
+  const T c0 = o.sound_speed * U;  // the flow around the blade's tip reaches about 2 U: c0 >= 10 x that
   const Resolution<T> res{dp, T(1.3)};
   System system(Domain<2, T>(V(-4 * dp, -4 * dp), V(tank + 4 * dp, depth + 4 * dp)), Tait<T>(rho, c0));
   add_fluid_block(system, V(0, 0), V(tank, depth), res, depth, T(0));
@@ -180,14 +185,18 @@ CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
       [=](T t) { return V(t < ramp ? U * (1 - std::cos(pi * t / ramp)) / 2 : U, 0); });
   FluidParameters<2, T> fluid;
   fluid.gravity = V::Zero();
-  fluid.artificial_viscosity = T(0.02);
+  fluid.artificial_viscosity = o.artificial_viscosity;
   fluid.thin_structure_visibility = o.visibility && !porous;  // the fluid passes a porous blade
   fluid.thin_structure_guard = o.guard;
+  fluid.background_pressure = o.background_pressure * rho * U * U;
   Coupling coupling;
   if constexpr (porous) {
     coupling.drag_coefficient = o.blade_cd;
     coupling.frontal_fraction = o.frontal_fraction;
-  } else {  // eq. 19 with k = 0.01: no hydrostatic load to balance here
+  } else {  // eq. 19 with k = 0.01 (no hydrostatic load to balance here), or the strength that holds the background
+            // pressure with the first fluid rows at dp / 2 on either face (their initial position)
+    if (fluid.background_pressure > 0)
+      coupling.strength = repulsive_strength_for_rest_pressure(fluid.background_pressure, rho, c0, res.smoothing_ratio);
     coupling.velocity_factor = o.velocity_factor;
     coupling.normal_damping = o.normal_damping;
   }
@@ -313,6 +322,9 @@ int main(int argc, char** argv) try {
   o.speed = cli.get_number("speed", o.speed, "towing speed U, m/s");
   o.length = cli.get_number("length", o.length, "blade length l, m");
   o.thickness = cli.get_number("thickness", o.thickness, "blade thickness t, m");
+  o.density = cli.get_number("blade-density", o.density,
+                             "blade density rho_s, kg/m^3 (its inertia only: g = 0; sets the mass ratio rho_s t / "
+                             "(rho l)), [100, 1e6]");
   o.particles_along = cli.get_number("resolution", o.particles_along, "fluid particles along the blade, l / dp");
   o.rod_spacing = cli.get_number("rod-spacing", o.rod_spacing, "rod node spacing / dp, [0.05, 2]");
   o.tow_lengths = cli.get_number("tow-lengths", o.tow_lengths, "towing distance after the ramp, blade lengths");
@@ -338,6 +350,17 @@ int main(int argc, char** argv) try {
   o.global_step =
       cli.get_switch("global-step", false,
                      "on: the fluid steps with the rod's stable step (no sub-cycling; for the cost comparison) | off");
+  o.sound_speed = cli.get_number("sound-speed", o.sound_speed,
+                                 "the fluid's artificial sound speed c0 over the towing speed U, [10, 200]");
+  require_in_range("--sound-speed (c0 / U)", o.sound_speed, T(10), T(200));
+  o.artificial_viscosity =
+      cli.get_number("alpha", o.artificial_viscosity, "alpha of the artificial viscosity, nu = alpha h c0 / 8, [0, 1]");
+  require_in_range("--alpha", o.artificial_viscosity, T(0), T(1));
+  o.background_pressure = cli.get_number(
+      "background-pressure", o.background_pressure,
+      "resolved blade: the fluid's background pressure over rho U^2, which holds the fluid on the blade's "
+      "lee face in the wake's suction (0: none), [0, 100]");
+  require_in_range("--background-pressure (rho U^2)", o.background_pressure, T(0), T(100));
   o.end_time = cli.get_number("end-time", 0, "simulated time, s (0: the ramp and the whole towing distance)");
   require_non_negative("--end-time (s)", o.end_time);
   o.depth_lengths = cli.get_number("depth", o.depth_lengths, "channel depth in blade lengths (blockage 1 / depth)");
@@ -360,6 +383,7 @@ int main(int argc, char** argv) try {
     throw InputError(fmt::format("--coupling '{}': valid are repulsive, drag", o.coupling));
   require_positive("--length (m)", o.length);
   require_positive("--thickness (m)", o.thickness);
+  require_in_range("--blade-density (kg/m^3)", o.density, T(100), T(1e6));
   require_in_range("--resolution (l / dp)", o.particles_along, T(5), T(200));
   require_in_range("--rod-spacing (ds / dp)", o.rod_spacing, T(0.05), T(2));
   require_in_range("--depth (blade lengths)", o.depth_lengths, T(1.5), T(20));

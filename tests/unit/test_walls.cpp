@@ -187,3 +187,78 @@ TEST_CASE("hydrostatic tank, coarse, repulsive walls: hydrostatic mid-depth pres
           "[walls][tank]") {
   check_coarse_tank(WallModel::repulsive, 0.03);
 }
+
+// Background pressure (FluidParameters::background_pressure). A confined block without gravity, W x H = 0.4 x 0.2 m at
+// dp = 0.02 m, c0 = 15 m/s, background pressure P = 500 Pa.
+// (1) Closed by dynamic walls (three layers, a lid too) every fluid particle has a full lattice support: the background
+//     pressure adds no force, to round-off of its scale P / (rho0 dp) = 25 m/s^2 (it would push the first rows onto
+//     the walls if the walls' pressures did not carry it too).
+// (2) Closed by repulsive walls, whose fluid supports are cut: the background pressure pushes the first rows onto the
+//     walls, and repulsive_strength_for_rest_pressure(P) holds them there at the block's reference density. After
+//     0.3 s (11 acoustic crossings of the block) the mean pressure stays within 0.1 P of zero (measured -0.05 P: the
+//     formula assumes a flat wall and a semi-infinite lattice; the corners and the rows' settling are not in it).
+//     The same walls without the background pressure compress the block until its own pressure carries them, mean
+//     pressure about P (measured 1.2 P; bound > 0.5 P), so the check can fail.
+TEST_CASE("background pressure: no force in a full support; repulsive walls hold it at the rest-pressure strength",
+          "[walls][fluid]") {
+  const double dp = 0.02, P = 500, c0 = 15, W = 0.4, H = 0.2, rho0 = 1000;
+  const Resolution<double> res{dp, 1.3};
+  const auto block = [&](WallModel walls) {
+    System2 system(Domain<2, double>(V2(-0.2, -0.2), V2(0.6, 0.5)), Tait<double>(rho0, c0));
+    add_fluid_block(system, V2(0, 0), V2(W, H), res, H, 0.0);
+    add_box_walls(system, V2(0, 0), V2(W, H), res, walls);
+    if (walls == WallModel::dynamic) {
+      for_each_lattice_point<2, double>(V2(-3 * dp, H), V2(W + 3 * dp, H + 3 * dp), dp, [&](const V2& x) {
+        system.particles().add(Kind::wall, x, V2::Zero(), rho0, rho0 * dp * dp, res.h(), 0);
+      });
+    } else {
+      const double db = repulsive_wall_spacing(W, res);
+      for (int i = 0; i <= std::lround(W / db); ++i) {
+        const auto s = system.particles().add(Kind::wall, V2(i * db, H), V2::Zero(), rho0, rho0 * dp * dp, res.h(), 0);
+        system.particles().normal[s] = V2(0, -1);
+      }
+    }
+    return system;
+  };
+  FluidParameters<2, double> f;
+  f.gravity = V2::Zero();
+  f.background_pressure = P;
+  SECTION("full support") {
+    System2 system = block(WallModel::dynamic);
+    WcsphFluid<System2> fluid(f);
+    system.update_neighbors();
+    system.update_pressure();
+    fluid.compute_rates(system);
+    const auto& p = system.particles();
+    double largest = 0;
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (p.kind[i] == Kind::fluid) largest = std::max(largest, p.acceleration[i].norm());
+    CHECK(largest < 1e-10 * P / (rho0 * dp));
+  }
+  SECTION("repulsive walls") {
+    const bool background = GENERATE(true, false);
+    CAPTURE(background);
+    System2 system = block(WallModel::repulsive);
+    f.walls = WallModel::repulsive;
+    f.repulsive.boundary_spacing = repulsive_wall_spacing(W, res);
+    f.repulsive.strength = repulsive_strength_for_rest_pressure(P, rho0, c0, res.smoothing_ratio);
+    if (!background) f.background_pressure = 0;
+    Simulation<System2, SymplecticVerlet> sim(system, f);
+    sim.run(0.3);
+    const auto& p = sim.system().particles();
+    double mean = 0;
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (p.kind[i] == Kind::fluid) {
+        mean += sim.system().eos().pressure(p.density[i]);
+        ++n;
+      }
+    mean /= double(n);
+    if (background) CHECK(std::abs(mean) < 0.1 * P);
+    else CHECK(mean > 0.5 * P);
+  }
+  FluidParameters<2, double> bad;
+  bad.background_pressure = -1;
+  CHECK_THROWS_WITH(bad.validate(), Catch::Contains("background_pressure"));
+  CHECK_THROWS_AS(repulsive_strength_for_rest_pressure(0.0, rho0, c0, 1.3), InputError);
+}

@@ -74,19 +74,33 @@ struct RepulsiveForceParameters {
 /// line, 1 for the surface particles of an SPH solid (whose surface lies dp/2 outside its particle centres). With
 /// the depth factor eps(z) = |z| / D of eq. 22 the same strength balances the hydrostatic load on a vertical wall.
 template <Real T>
+T repulsive_strength_for_rest_pressure(T pressure, T density, T c0, T smoothing_ratio, T first_row = T(0.5));
+
+template <Real T>
 T repulsive_strength_for_rest_gap(T depth, T gravity, T c0, T smoothing_ratio, T first_row = T(0.5)) {
-  require_in_range("repulsive_strength_for_rest_gap first_row (in dp)", first_row, T(0.1), T(2));
   require_positive("repulsive_strength_for_rest_gap depth (m)", depth);
   require_positive("repulsive_strength_for_rest_gap gravity (m/s^2)", gravity);
-  require_positive("repulsive_strength_for_rest_gap c0 (m/s)", c0);
-  require_in_range("repulsive_strength_for_rest_gap smoothing_ratio (h/dp)", smoothing_ratio, T(0.5), T(5));
+  return repulsive_strength_for_rest_pressure(gravity * depth, T(1), c0, smoothing_ratio, first_row);  // p / rho0
+}
+
+/// Strength k with which fluid of density `density` (kg/m^3) at a uniform pressure `pressure` (Pa) rests against a
+/// repulsive wall with its first particle row at first_row x dp from it: the load rho0 g D of the header comment
+/// replaced by p, e.g. the background pressure of a confined flow without gravity (FluidParameters::
+/// background_pressure), which holds the fluid on both faces of a thin blade.
+template <Real T>
+T repulsive_strength_for_rest_pressure(T pressure, T density, T c0, T smoothing_ratio, T first_row) {
+  require_in_range("repulsive strength first_row (in dp)", first_row, T(0.1), T(2));
+  require_positive("repulsive strength pressure (Pa)", pressure);
+  require_positive("repulsive strength density (kg/m^3)", density);
+  require_positive("repulsive strength c0 (m/s)", c0);
+  require_in_range("repulsive strength smoothing_ratio (h/dp)", smoothing_ratio, T(0.5), T(5));
   T rows = T(0);
   for (int j = 0;; ++j) {
     const T q = (T(j) + first_row) / (T(2) * smoothing_ratio);
     if (q >= T(1)) break;
     rows += (T(1) - q) / std::sqrt(q);
   }
-  return gravity * depth * smoothing_ratio / (c0 * c0 * rows);
+  return (pressure / density) * smoothing_ratio / (c0 * c0 * rows);
 }
 
 /// Depth factor eps(z) of eq. 22, z = elevation above the local water level, h0 = local depth.

@@ -99,6 +99,15 @@ struct FluidParameters {
   /// Fluid pressure floor, Pa (-inf: none). 0 stops spray clusters from collapsing under negative pressure
   /// (tensile instability, Swegle et al. 1995): water in a thin jet cannot sustain tension.
   T minimum_pressure{-std::numeric_limits<T>::infinity()};
+  /// Background pressure p_bg, Pa, finite and >= 0 (0: none): added to every fluid
+  /// and wall pressure in the symmetric pressure gradient, sum_b m_b ((p_a + p_bg) / rho_a^2 + (p_b + p_bg) / rho_b^2)
+  /// grad W (Morris, Fox & Zhu 1997; Adami, Hu & Adams 2013). In a full support it adds no force (to the lattice's
+  /// round-off); where a support is cut, at the faces of a thin structure under the visibility criterion, it pushes
+  /// the fluid against the structure as the ambient pressure of a real flow does. A repulsive face can only push:
+  /// without it the fluid in a wake, below the reference pressure, leaves the lee face (a confined flow with g = 0 has
+  /// no hydrostatic pressure to hold it there; docs/thin-blades.md). For confined flows: at a free surface it would
+  /// push the surface particles out. The corrected-gradient forms use pressure differences and do not see it.
+  T background_pressure{0};
   /// Pairs whose segment crosses an edge of a thin structure (WcsphFluid::set_structure_edges) do not interact
   /// (true); false: the published edges are ignored and the fluid interacts through the structure in its sums.
   bool thin_structure_visibility{false};
@@ -124,6 +133,8 @@ struct FluidParameters {
     if (!(minimum_pressure <= T(0)))
       throw InputError(fmt::format("FluidParameters::minimum_pressure = {} Pa is invalid: valid range is [-inf, 0]",
                                    minimum_pressure));
+    require_non_negative("FluidParameters::background_pressure (Pa)", background_pressure);
+    require_finite("FluidParameters::background_pressure (Pa)", background_pressure);
     if (walls == WallModel::repulsive)
       require_positive("FluidParameters::repulsive.boundary_spacing (m)", repulsive.boundary_spacing);
   }
@@ -201,9 +212,10 @@ class WcsphFluid {
     signal_speed_.assign(n, T(0));
     pressure_term_.resize(n);
     volume_.resize(n);
+    const T background = params_.background_pressure;
     parallel_for(n, [&](std::size_t a) {
-      pressure_term_[a] = p.pressure[a] / (p.density[a] * p.density[a]);  // p / rho^2, Pa m^6/kg^2
-      volume_[a] = p.mass[a] / p.density[a];                              // m^3 (m^2 in 2D)
+      pressure_term_[a] = (p.pressure[a] + background) / (p.density[a] * p.density[a]);  // p / rho^2, Pa m^6/kg^2
+      volume_[a] = p.mass[a] / p.density[a];                                             // m^3 (m^2 in 2D)
       if (frozen_ && frozen_[a]) return;
       p.acceleration[a] = Vector::Zero();
       p.density_rate[a] = T(0);
