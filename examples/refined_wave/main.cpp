@@ -279,8 +279,9 @@ int main(int argc, char** argv) try {
     if constexpr (adaptive)
       fmt::print(
           "mass account: largest correction of the edge particles' masses {:.2e} (one pass); momentum account: largest "
-          "velocity shift {:.2e} m/s\n",
-          refinement.total_counts().mass_correction, refinement.total_counts().momentum_correction);
+          "velocity shift {:.2e} m/s; status changes: {} activated, {} deactivated\n",
+          refinement.total_counts().mass_correction, refinement.total_counts().momentum_correction,
+          refinement.total_counts().activated, refinement.total_counts().deactivated);
 
     {
       io::CsvWriter particles_csv(out / "particles.csv", {"x", "z", "level", "pressure", "speed", "passive"},
