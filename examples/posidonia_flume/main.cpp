@@ -139,7 +139,8 @@ scenes::PosidoniaFlume<T> converted(const scenes::PosidoniaFlume<double>& s) {
                   s.refinement.shifting,
                   T(s.refinement.shift_coefficient),
                   s.refinement.shift_passive,
-                  s.refinement.limit_fit};
+                  s.refinement.limit_fit,
+                  T(s.refinement.status_hysteresis)};
   return c;
 }
 
@@ -760,6 +761,9 @@ int main(int argc, char** argv) try {
       cli.get_switch("shift-passive", true, "refinement: shift the passive fine particles too: on | off");
   s.refinement.limit_fit = cli.get_switch(
       "limit-fit", false, "refinement: the passive particles' linear fit limited to its neighbours' range: on | off");
+  s.refinement.status_hysteresis = cli.get_number(
+      "hysteresis", 0,
+      "refinement: a particle keeps its status within this distance of a box edge, base spacings, [0, 1]");
   o.local_steps = cli.get_switch("local-steps", false,
                                  "refinement: local time stepping, the coarse fluid at twice the fine step: on | off");
   o.uniform_viscosity = cli.get_switch(

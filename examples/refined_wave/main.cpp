@@ -108,6 +108,8 @@ int main(int argc, char** argv) try {
   const bool linear = cli.get_switch("linear", true, "apr: passive values by a linear MLS fit: on | off");
   const bool limit_fit = cli.get_switch("limit-fit", false,
                                         "apr: the linear fit limited to the range of its neighbours' values: on | off");
+  const double hysteresis = cli.get_number(
+      "hysteresis", 0, "apr: a particle keeps its status within this distance of a box edge, base spacings, [0, 1]");
   const bool account = cli.get_switch("account", true, "apr: the mass account: on | off");
   const bool momentum_account = cli.get_switch("momentum-account", true, "apr: the momentum account: on | off");
   const bool volume_mass =
@@ -172,6 +174,7 @@ int main(int argc, char** argv) try {
   apr_params.interpolate_from_own_level = own_level;
   apr_params.linear_interpolation = linear;
   apr_params.limit_fit = limit_fit;
+  apr_params.status_hysteresis = hysteresis;
   apr_params.conserve_mass = account;
   apr_params.conserve_momentum = momentum_account;
   apr_params.passive_mass_from_volume = volume_mass;

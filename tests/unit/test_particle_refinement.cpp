@@ -853,3 +853,50 @@ TEST_CASE("adaptive refinement: particle shifting moves the refined level only",
     CHECK(apr.last_shift_counts().largest_shift <= block.params.shifting.max_shift + 1e-12);
   }
 }
+
+// Status hysteresis at a box edge (AdaptiveRefinementParameters::status_hysteresis). The block of AprBlock oscillates
+// rigidly by +-0.3 dp along x (20 passes, each moving it 0.6 dp one way, then back): fine particles near the box's
+// vertical edges cross them at every pass, so without hysteresis statuses change at every pass. With a hysteresis of
+// 0.4 dp (more than the 0.3 dp excursion) a particle may change once in the first cycle (one whose excursion reaches
+// 0.4 dp past an edge) and then never: none changes from the third pass on. Drifting 4 dp one
+// way instead, every particle that goes more than 0.4 dp past an edge changes once, so there are status changes with
+// the hysteresis too, and the mass account still conserves the active mass to round-off.
+TEST_CASE("adaptive refinement: status hysteresis stops particles oscillating across a box edge from changing status",
+          "[refinement][apr]") {
+  for (const double hysteresis : {0.0, 0.4}) {
+    AprBlock block;
+    block.params.status_hysteresis = hysteresis;
+    auto& p = block.system.particles();
+    for (std::size_t i = 0; i < p.size(); ++i) p.position[i][0] -= 0.3 * AprBlock::dp;  // start at one extreme
+    Apr apr(block.system.domain(), block.boxes, block.params);
+    apr.populate(block.system);
+    const double mass0 = apr.active_mass_momentum(block.system).first;
+    std::size_t changes = 0;
+    for (int pass = 0; pass < 20; ++pass) {
+      const double dx = (pass % 2 == 0 ? 0.6 : -0.6) * AprBlock::dp;
+      for (std::size_t i = 0; i < p.size(); ++i) p.position[i][0] += dx;
+      block.system.update_neighbors(pass * 1e-3);
+      apr.advance(block.system, pass * 1e-3, 1e-3);
+      if (pass >= 2) changes += apr.last_counts().activated + apr.last_counts().deactivated;
+    }
+    INFO("hysteresis " << hysteresis << " dp: status changes in passes 3-20 " << changes);
+    if (hysteresis > 0) CHECK(changes == 0);
+    else CHECK(changes >= 18 * 16);  // the fine column along each vertical edge (16 particles) at every pass
+    AprBlock drifting;
+    drifting.params.status_hysteresis = hysteresis;
+    for (std::size_t i = 0; i < drifting.system.particles().size(); ++i)
+      drifting.system.particles().velocity[i] = V2(0.5, 0);
+    Apr drifting_apr(drifting.system.domain(), drifting.boxes, drifting.params);
+    drifting_apr.populate(drifting.system);
+    const double drift_mass0 = drifting_apr.active_mass_momentum(drifting.system).first;
+    const std::size_t drift_changes = drifting.drift(drifting_apr, 0.2 * AprBlock::dp / 0.5, [] {});
+    CHECK(drift_changes > 0);
+    CHECK(std::abs(drifting_apr.active_mass_momentum(drifting.system).first - drift_mass0) <= 1e-12 * drift_mass0);
+    CHECK(apr.active_mass_momentum(block.system).first == Approx(mass0).epsilon(1e-12));
+  }
+  AdaptiveRefinementParameters<double> bad;
+  bad.base_spacing = 0.01;
+  bad.transition_width = 0.02;
+  bad.status_hysteresis = 1.5;
+  CHECK_THROWS_WITH(bad.validate(), Catch::Contains("status_hysteresis"));
+}

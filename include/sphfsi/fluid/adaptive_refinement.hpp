@@ -113,6 +113,11 @@ struct AdaptiveRefinementParameters {
   /// Whether a passive particle's mass is its SPH volume times its density (capped at the nominal mass), else the
   /// nominal mass rho0 s^Dim.
   bool passive_mass_from_volume{true};
+  /// Hysteresis of the active / passive status at a box edge, in base spacings, [0, 1]: within this distance of an
+  /// edge (on either side) a particle keeps its status, so one that oscillates across the edge by less (the orbital
+  /// motion of a wave, the jitter of the particles) does not change it at every pass; it changes once the particle is
+  /// this far past the edge. 0: the status follows the position exactly.
+  T status_hysteresis{0};
   /// Particle shifting (fluid/particle_shifting.hpp) of the active particles before each pass; off by default. With
   /// shift_refined_only, on the refined levels only (its max_smoothing_length is then set between levels 0 and 1),
   /// so the base fluid stays that of the uniform scene.
@@ -126,6 +131,7 @@ struct AdaptiveRefinementParameters {
     require_in_open_range("AdaptiveRefinementParameters::split_offset (eps)", split_offset, T(0), T(0.5));
     require_in_range("AdaptiveRefinementParameters::smoothing_ratio (h/dp)", smoothing_ratio, T(0.5), T(3));
     require_in_range("AdaptiveRefinementParameters::occupied_fraction", occupied_fraction, T(0.25), T(1));
+    require_in_range("AdaptiveRefinementParameters::status_hysteresis (base spacings)", status_hysteresis, T(0), T(1));
     if (!(bunched_fraction >= T(0.1) && bunched_fraction < occupied_fraction))
       throw InputError(
           fmt::format("AdaptiveRefinementParameters::bunched_fraction = {} is invalid: valid range is [0.1, {}) (below "
@@ -351,6 +357,7 @@ class AdaptiveRefinement {
     const bool account = initial_level < 0 && (params_.conserve_mass || params_.conserve_momentum);
     const auto before = account ? active_mass_momentum(system) : std::pair{T(0), Vector::Zero().eval()};
     // 1. Statuses; particles finer than every box within transition_width of them are removed.
+    const T hysteresis = params_.status_hysteresis * params_.base_spacing;
     level_.assign(n, 0);
     leaving_.assign(n, 0);
     removals_.clear();
@@ -364,7 +371,12 @@ class AdaptiveRefinement {
         leaving_[a] = 1;
         continue;
       }
-      const std::uint8_t passive = k != inside ? 1 : 0;
+      std::uint8_t passive = k != inside ? 1 : 0;
+      if (hysteresis > T(0) && initial_level < 0) {
+        // within `hysteresis` of an edge where k is the active level on one side: keep the status
+        const int strict = highest_level(p.position[a], -hysteresis), loose = highest_level(p.position[a], hysteresis);
+        if (strict != loose && (k == strict || k == loose)) passive = p.passive[a];
+      }
       if (passive != p.passive[a]) {
         ++(passive ? counts.deactivated : counts.activated);
       }

@@ -77,6 +77,7 @@ struct PlantRefinement {
   T shift_coefficient{T(2)};    ///< A of the shift (fluid/particle_shifting.hpp), (0, 10]
   bool shift_passive{true};     ///< with shifting: the passive fine particles (transition zone) are shifted too
   bool limit_fit{false};        ///< AdaptiveRefinementParameters::limit_fit (the passive fit within its data's range)
+  T status_hysteresis{T(0)};    ///< AdaptiveRefinementParameters::status_hysteresis, base spacings, [0, 1]
 };
 
 /// The Posidonia flume: waves, resolution, plants and blade model (lengths in m).
@@ -201,6 +202,7 @@ struct PosidoniaFlume {
     a.shifting.coefficient = refinement.shift_coefficient;
     a.shifting.include_passive = refinement.shift_passive;
     a.limit_fit = refinement.limit_fit;
+    a.status_hysteresis = refinement.status_hysteresis;
     return a;
   }
   /// The real blade as a line of rod nodes (rod, drag), not a continuum of particle rows (scaled, equivalent).
