@@ -67,28 +67,12 @@ struct RepulsiveForceParameters {
   }
 };
 
-/// Strength k (A = k c0^2 / h) with which a still water column of depth `depth` (m) under gravity `gravity`
-/// (m/s^2) rests on a repulsive wall with its first particle row at dp/2 from it, for sound speed c0 (m/s) and
-/// smoothing ratio h / dp (see the header comment). For c0 = 10 sqrt(g D) and h = 1.3 dp it is 0.0053.
-/// first_row is the distance of the first fluid row from the boundary particles in units of dp: 1/2 for a wall
-/// line, 1 for the surface particles of an SPH solid (whose surface lies dp/2 outside its particle centres). With
-/// the depth factor eps(z) = |z| / D of eq. 22 the same strength balances the hydrostatic load on a vertical wall.
-template <Real T>
-T repulsive_strength_for_rest_pressure(T pressure, T density, T c0, T smoothing_ratio, T first_row = T(0.5));
-
-template <Real T>
-T repulsive_strength_for_rest_gap(T depth, T gravity, T c0, T smoothing_ratio, T first_row = T(0.5)) {
-  require_positive("repulsive_strength_for_rest_gap depth (m)", depth);
-  require_positive("repulsive_strength_for_rest_gap gravity (m/s^2)", gravity);
-  return repulsive_strength_for_rest_pressure(gravity * depth, T(1), c0, smoothing_ratio, first_row);  // p / rho0
-}
-
 /// Strength k with which fluid of density `density` (kg/m^3) at a uniform pressure `pressure` (Pa) rests against a
 /// repulsive wall with its first particle row at first_row x dp from it: the load rho0 g D of the header comment
 /// replaced by p, e.g. the background pressure of a confined flow without gravity (FluidParameters::
 /// background_pressure), which holds the fluid on both faces of a thin blade.
 template <Real T>
-T repulsive_strength_for_rest_pressure(T pressure, T density, T c0, T smoothing_ratio, T first_row) {
+T repulsive_strength_for_rest_pressure(T pressure, T density, T c0, T smoothing_ratio, T first_row = T(0.5)) {
   require_in_range("repulsive strength first_row (in dp)", first_row, T(0.1), T(2));
   require_positive("repulsive strength pressure (Pa)", pressure);
   require_positive("repulsive strength density (kg/m^3)", density);
@@ -101,6 +85,19 @@ T repulsive_strength_for_rest_pressure(T pressure, T density, T c0, T smoothing_
     rows += (T(1) - q) / std::sqrt(q);
   }
   return (pressure / density) * smoothing_ratio / (c0 * c0 * rows);
+}
+
+/// Strength k (A = k c0^2 / h) with which a still water column of depth `depth` (m) under gravity `gravity`
+/// (m/s^2) rests on a repulsive wall with its first particle row at dp/2 from it, for sound speed c0 (m/s) and
+/// smoothing ratio h / dp (see the header comment). For c0 = 10 sqrt(g D) and h = 1.3 dp it is 0.0053.
+/// first_row is the distance of the first fluid row from the boundary particles in units of dp: 1/2 for a wall
+/// line, 1 for the surface particles of an SPH solid (whose surface lies dp/2 outside its particle centres). With
+/// the depth factor eps(z) = |z| / D of eq. 22 the same strength balances the hydrostatic load on a vertical wall.
+template <Real T>
+T repulsive_strength_for_rest_gap(T depth, T gravity, T c0, T smoothing_ratio, T first_row = T(0.5)) {
+  require_positive("repulsive_strength_for_rest_gap depth (m)", depth);
+  require_positive("repulsive_strength_for_rest_gap gravity (m/s^2)", gravity);
+  return repulsive_strength_for_rest_pressure(gravity * depth, T(1), c0, smoothing_ratio, first_row);  // p / rho0
 }
 
 /// Depth factor eps(z) of eq. 22, z = elevation above the local water level, h0 = local depth.
