@@ -14,8 +14,9 @@
 // with C_D = F_rigid / (rho U^2 l / 2) measured on the rigid blade (per unit width: b cancels in 2D).
 // The Cauchy number is set through E at fixed U, l, t (same Reynolds number for every case).
 //
-// Writes <output>/summary.csv (one row per case), <output>/case_<Ca>.csv (drag and tip position vs time) and
-// <output>/effective_length.png (plot.py).
+// Writes <output>/summary.csv (one row per case), <output>/case_<Ca>.csv (drag, tip position and the fluid under the
+// folded blade vs time), <output>/shape_<Ca>.csv (over the averaging window: the mean node positions from the base
+// and the mean force of the fluid on each node, N/m) and <output>/effective_length.png (plot.py).
 #include <sphfsi/analysis/reconfiguration.hpp>
 #include <sphfsi/core/particle_system.hpp>
 #include <sphfsi/coupling/blade_drag.hpp>
@@ -100,6 +101,7 @@ struct CaseResult {
   std::size_t steps, particles;
   T lift = 0, lift_error = 0;  // mean vertical force on the blade (up > 0), N/m, and its standard error
   T tip_height_rms = 0;        // standard deviation of the tip's height over the averaging window, m (flutter)
+  T fluid_under = 0;           // mean fluid area under the folded blade over the averaging window, in l^2
 };
 
 /// Mean of the samples and its standard error from 8 blocks (the samples are correlated within a block); NaN when
@@ -118,6 +120,35 @@ std::pair<T, T> block_mean(const std::vector<T>& samples) {
     var += (m - mean) * (m - mean);
   }
   return {mean, std::sqrt(var / T(blocks * (blocks - 1)))};
+}
+
+/// Fluid under the blade: the area (per unit width, m^2) of the fluid particles that lie below the blade's lowest
+/// point in their column (columns of dp / 2 over the blade's horizontal extent), i.e. between a folded blade and the
+/// bed. In 2D the blade spans the whole width, so this fluid can leave only past the tip.
+template <class Ids>
+T fluid_under_blade(const ParticleSet<2, T>& p, const Ids& ids, T dp) {
+  T x_min = std::numeric_limits<T>::max(), x_max = -x_min;
+  for (auto id : ids) {
+    const T x = p.position[p.slot_of_id(id)][0];
+    x_min = std::min(x_min, x);
+    x_max = std::max(x_max, x);
+  }
+  const T column = dp / 2;
+  const std::size_t columns = static_cast<std::size_t>((x_max - x_min) / column) + 1;
+  std::vector<T> lowest(columns, std::numeric_limits<T>::max());
+  for (std::size_t k = 0; k + 1 < ids.size(); ++k) {
+    const V a = p.position[p.slot_of_id(ids[k])], b = p.position[p.slot_of_id(ids[k + 1])];
+    const auto first = static_cast<std::size_t>((std::min(a[0], b[0]) - x_min) / column);
+    const auto last = static_cast<std::size_t>((std::max(a[0], b[0]) - x_min) / column);
+    for (std::size_t c = first; c <= last && c < columns; ++c) lowest[c] = std::min({lowest[c], a[1], b[1]});
+  }
+  T area = 0;
+  for (std::size_t f = 0; f < p.size(); ++f) {
+    if (p.kind[f] != Kind::fluid || p.position[f][0] < x_min || p.position[f][0] > x_max) continue;
+    const auto c = static_cast<std::size_t>((p.position[f][0] - x_min) / column);
+    if (c < columns && p.position[f][1] < lowest[c]) area += p.mass[f] / p.density[f];
+  }
+  return area;
 }
 
 /// Runs one blade: flexible at the target Cauchy number, or rigid (target_ca = 0). `inclination`: the blade's rest
@@ -208,11 +239,14 @@ CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
   sim.set_expected_flow_speed(2 * U);
 
   const std::string label = target_ca > 0 ? fmt::format("{:g}", target_ca) : "rigid";
-  io::CsvWriter csv(o.output / fmt::format("case_{}.csv", label), {"t", "drag", "lift", "tip_dx", "tip_dy"});
+  io::CsvWriter csv(o.output / fmt::format("case_{}.csv", label),
+                    {"t", "drag", "lift", "tip_dx", "tip_dy", "fluid_under"});
   const T t_end = o.end_time > 0 ? o.end_time : ramp + tow / U, t_avg = ramp + o.average_from * l / U;
   const auto& ids = sim.template model<0>().solid().particle_ids();
   std::vector<T> samples, lift_samples;
-  T tip_x = 0, tip_y = 0, tip_y_squared = 0;
+  // node positions relative to the base and the couplings' force on each node, summed over the averaging window
+  std::vector<V> mean_shape(ids.size(), V::Zero()), mean_load(ids.size(), V::Zero());
+  T tip_x = 0, tip_y = 0, tip_y_squared = 0, under_sum = 0;
   std::size_t tip_n = 0;
   io::ProgressReporter progress(t_end);
   const auto start = std::chrono::steady_clock::now();
@@ -233,13 +267,20 @@ CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
     const V force = s.template model<0>().solid().coupling_force(p);
     const T drag = -force[0];
     const V base = p.position[p.slot_of_id(ids.front())], tip = p.position[p.slot_of_id(ids.back())];
-    csv.write_row({s.time(), drag, force[1], tip[0] - base[0], tip[1] - base[1]});
+    const T under = porous ? T(0) : fluid_under_blade(p, ids, dp) / (l * l);
+    csv.write_row({s.time(), drag, force[1], tip[0] - base[0], tip[1] - base[1], under});
     if (s.time() >= t_avg) {
       samples.push_back(drag);
       lift_samples.push_back(force[1]);
       tip_x += tip[0] - base[0];
       tip_y += tip[1] - base[1];
       tip_y_squared += (tip[1] - base[1]) * (tip[1] - base[1]);
+      for (std::size_t k = 0; k < ids.size(); ++k) {
+        const std::size_t slot = p.slot_of_id(ids[k]);
+        mean_shape[k] += p.position[slot] - base;
+        mean_load[k] += p.mass[slot] * p.acceleration[slot];
+      }
+      under_sum += under;
       ++tip_n;
     }
   });
@@ -251,12 +292,18 @@ CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
   const auto [mean, se] = block_mean(samples);
   const auto [lift, lift_se] = block_mean(lift_samples);
   const T n = T(tip_n), height = tip_y / n;
+  if (tip_n > 0) {  // the blade's mean posture over the averaging window, base to tip
+    io::CsvWriter shape(o.output / fmt::format("shape_{}.csv", label), {"node", "dx", "dy", "force_x", "force_y"});
+    for (std::size_t k = 0; k < ids.size(); ++k)
+      shape.write_row({T(k), mean_shape[k][0] / n, mean_shape[k][1] / n, mean_load[k][0] / n, mean_load[k][1] / n});
+  }
   return {target_ca,     material.youngs_modulus,
           mean,          se,
           tip_x / n,     height,
           wall,          sim.step_count(),
           system.size(), lift,
-          lift_se,       std::sqrt(std::max(tip_y_squared / n - height * height, T(0)))};
+          lift_se,       std::sqrt(std::max(tip_y_squared / n - height * height, T(0))),
+          under_sum / n};
 }
 
 /// The local force law of the resolved blade, measured on rigid blades inclined by theta from the vertical: per unit
@@ -413,7 +460,7 @@ int main(int argc, char** argv) try {
       if (ca == 0) throw;             // without the rigid reference there is nothing to compare with
       fmt::print(stderr, "Ca = {:g}: run stopped: {}\n", ca, e.what());
       const T nan = std::numeric_limits<T>::quiet_NaN();
-      results.push_back({ca, nan, nan, nan, nan, nan, 0, 0, 0, nan, nan, nan});
+      results.push_back({ca, nan, nan, nan, nan, nan, 0, 0, 0, nan, nan, nan, nan});
     }
   }
   if (o.end_time > 0) {  // a short run (the sub-cycling comparison): cost only, the records are in case_*.csv
@@ -431,11 +478,11 @@ int main(int argc, char** argv) try {
   io::CsvWriter summary(
       o.output / "summary.csv",
       {"target_ca", "ca", "youngs_modulus", "drag", "drag_error", "effective_length", "effective_length_error", "model",
-       "model_static", "model_2d", "tip_dx", "tip_dy", "tip_dy_rms", "steps", "particles", "wall_s"});
+       "model_static", "model_2d", "tip_dx", "tip_dy", "tip_dy_rms", "steps", "particles", "wall_s", "fluid_under"});
   fmt::print(
       "| Ca | E (Pa) | F (N/m) | l_e/l SPH | l_e/l model (fit) | deviation | static model | measured-law model (SPH's "
-      "deviation) | tip (dx, dy)/l | tip height rms / l | wall (s) |\n");
-  fmt::print("|---|---|---|---|---|---|---|---|---|---|---|\n");
+      "deviation) | tip (dx, dy)/l | tip height rms / l | fluid under / l^2 | wall (s) |\n");
+  fmt::print("|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   T worst = 0;
   for (const auto& r : results) {
     const T ca = r.target_ca > 0 ? r.target_ca * drag_coefficient / o.nominal_drag : 0;
@@ -448,14 +495,15 @@ int main(int argc, char** argv) try {
                                 : T(1);
     if (ca > 0) worst = std::max(worst, std::abs(le - model) / model);
     summary.write_row({r.target_ca, ca, r.youngs_modulus, r.drag, r.drag_error, le, le_err, model, model_static,
-                       model_2d, r.tip_x, r.tip_y, r.tip_height_rms, T(r.steps), T(r.particles), r.wall});
+                       model_2d, r.tip_x, r.tip_y, r.tip_height_rms, T(r.steps), T(r.particles), r.wall,
+                       r.fluid_under});
     fmt::print(
         "| {} | {:.3g} | {:.4g} | {:.3f} +- {:.3f} | {:.3f} | {:+.1f} % | {:.3f} | {} | ({:.2f}, {:.2f}) | {:.2f} | "
-        "{:.0f} |\n",
+        "{:.3f} | {:.0f} |\n",
         ca > 0 ? fmt::format("{:.3g}", ca) : std::string("rigid"), r.youngs_modulus, r.drag, le, le_err, model,
         ca > 0 ? 100 * (le - model) / model : 0.0, model_static,
         law ? fmt::format("{:.3f} ({:+.1f} %)", model_2d, 100 * (le - model_2d) / model_2d) : std::string("-"),
-        r.tip_x / o.length, r.tip_y / o.length, r.tip_height_rms / o.length, r.wall);
+        r.tip_x / o.length, r.tip_y / o.length, r.tip_height_rms / o.length, r.fluid_under, r.wall);
   }
   fmt::print("largest deviation from Luhar & Nepf: {:.1f} % ({} particles, dp = {:.3g} m)\n", 100 * worst,
              results.front().particles, o.length / o.particles_along);

@@ -140,7 +140,9 @@ scenes::PosidoniaFlume<T> converted(const scenes::PosidoniaFlume<double>& s) {
                   T(s.refinement.shift_coefficient),
                   s.refinement.shift_passive,
                   s.refinement.limit_fit,
-                  T(s.refinement.status_hysteresis)};
+                  T(s.refinement.status_hysteresis),
+                  T(s.refinement.account_relaxation),
+                  s.refinement.momentum_account};
   return c;
 }
 
@@ -764,6 +766,10 @@ int main(int argc, char** argv) try {
   s.refinement.status_hysteresis = cli.get_number(
       "hysteresis", 0,
       "refinement: a particle keeps its status within this distance of a box edge, base spacings, [0, 1]");
+  s.refinement.account_relaxation =
+      cli.get_number("account-relaxation", 0, "refinement: relaxation time of the mass account, s (0: at once), >= 0");
+  s.refinement.momentum_account =
+      cli.get_switch("momentum-account", true, "refinement: the momentum account: on | off");
   o.local_steps = cli.get_switch("local-steps", false,
                                  "refinement: local time stepping, the coarse fluid at twice the fine step: on | off");
   o.uniform_viscosity = cli.get_switch(

@@ -112,6 +112,16 @@ int main(int argc, char** argv) try {
       "hysteresis", 0, "apr: a particle keeps its status within this distance of a box edge, base spacings, [0, 1]");
   const bool account = cli.get_switch("account", true, "apr: the mass account: on | off");
   const bool momentum_account = cli.get_switch("momentum-account", true, "apr: the momentum account: on | off");
+  const std::string account_region =
+      cli.get("account-region", "edges",
+              "apr: the accounts hand their changes to the active particles near the box edges "
+              "(edges) or to all active fluid (all)");
+  const double account_relaxation =
+      cli.get_number("account-relaxation", 0,
+                     "apr: relaxation time of the mass account, s (0: each pass hands back its change at once), >= 0");
+  require_in_range("--account-relaxation (s)", account_relaxation, 0.0, 1e6);
+  if (account_region != "edges" && account_region != "all")
+    throw InputError(fmt::format("--account-region '{}': valid are edges, all", account_region));
   const bool volume_mass =
       cli.get_switch("volume-mass", true, "apr: passive masses from their SPH volume (else nominal): on | off");
   const bool shift = cli.get_switch("shift", false, "apr: particle shifting of the fine particles: on | off");
@@ -177,6 +187,8 @@ int main(int argc, char** argv) try {
   apr_params.status_hysteresis = hysteresis;
   apr_params.conserve_mass = account;
   apr_params.conserve_momentum = momentum_account;
+  apr_params.account_over_all_fluid = account_region == "all";
+  apr_params.mass_account_relaxation = account_relaxation;
   apr_params.passive_mass_from_volume = volume_mass;
   apr_params.shifting.enabled = shift;
   apr_params.shifting.coefficient = shift_coefficient;
@@ -282,9 +294,12 @@ int main(int argc, char** argv) try {
     if constexpr (adaptive)
       fmt::print(
           "mass account: largest correction of the edge particles' masses {:.2e} (one pass); momentum account: largest "
-          "velocity shift {:.2e} m/s; status changes: {} activated, {} deactivated\n",
+          "velocity shift {:.2e} m/s; status changes: {} activated, {} deactivated; largest pending mass of the "
+          "relaxed "
+          "account {:.2e} of the active mass ({:.2e} at the end)\n",
           refinement.total_counts().mass_correction, refinement.total_counts().momentum_correction,
-          refinement.total_counts().activated, refinement.total_counts().deactivated);
+          refinement.total_counts().activated, refinement.total_counts().deactivated,
+          refinement.total_counts().pending_mass, refinement.pending_mass() / fluid_mass());
 
     {
       io::CsvWriter particles_csv(out / "particles.csv", {"x", "z", "level", "pressure", "speed", "passive"},

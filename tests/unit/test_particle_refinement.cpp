@@ -811,6 +811,54 @@ TEST_CASE("adaptive refinement: the mass account conserves the active mass to ro
   }
 }
 
+// The relaxed mass account (mass_account_relaxation tau = 5 passes): the block drifts through the box as above, then
+// stands still for 20 passes (no status changes). The active mass plus the pending mass stays that of the block to
+// round-off after every pass; during the drift the pending mass is not zero (the account is relaxed, not immediate);
+// standing still it decays as exp(-t / tau) exactly (to 1e-9 relative); the pending mass survives a checkpoint.
+TEST_CASE("adaptive refinement: the relaxed mass account hands the pending mass back as exp(-t / tau)",
+          "[refinement][apr]") {
+  AprBlock block;
+  block.params.conserve_momentum = false;
+  const double dt = 0.2 * AprBlock::dp / 0.5, tau = 5 * dt;
+  block.params.mass_account_relaxation = tau;
+  auto& p = block.system.particles();
+  block.disorder();
+  for (std::size_t i = 0; i < p.size(); ++i) p.velocity[i] = V2(0.5, 0);
+  const double mass0 = fluid_totals(p).mass;
+  Apr apr(block.system.domain(), block.boxes, block.params);
+  apr.populate(block.system);
+  double worst_total = 0, largest_pending = 0;
+  const std::size_t changes = block.drift(apr, dt, [&] {
+    const double total = apr.active_mass_momentum(block.system).first + apr.pending_mass();
+    worst_total = std::max(worst_total, std::abs(total - mass0) / mass0);
+    largest_pending = std::max(largest_pending, std::abs(apr.pending_mass()) / mass0);
+  });
+  CHECK(changes > 0);
+  CHECK(worst_total <= 1e-12);
+  CHECK(largest_pending > 1e-6);
+  CHECK(apr.total_counts().pending_mass > 1e-6);
+  // standing still: no status changes, the pending mass decays by exp(-dt / tau) per pass
+  for (std::size_t i = 0; i < p.size(); ++i) p.velocity[i] = V2::Zero();
+  const double pending0 = apr.pending_mass();
+  REQUIRE(std::abs(pending0) / mass0 > 1e-9);
+  for (int step = 0; step < 20; ++step) {
+    apr.advance(block.system, (20 + step) * dt, dt);
+    REQUIRE(apr.last_counts().activated + apr.last_counts().deactivated == 0);
+    const double total = apr.active_mass_momentum(block.system).first + apr.pending_mass();
+    worst_total = std::max(worst_total, std::abs(total - mass0) / mass0);
+  }
+  INFO("largest pending mass " << largest_pending << " of the block's, " << changes << " status changes");
+  CHECK(worst_total <= 1e-12);
+  CHECK(apr.pending_mass() == Approx(pending0 * std::exp(-20 * dt / tau)).epsilon(1e-9));
+  // checkpoint: the pending mass and the last pass's time are restored
+  io::CheckpointWriter writer;
+  apr.save_checkpoint(writer);
+  Apr resumed(block.system.domain(), block.boxes, block.params);
+  io::CheckpointReader reader(writer.bytes().data(), writer.bytes().size(), "test");
+  resumed.load_checkpoint(reader);
+  CHECK(resumed.pending_mass() == apr.pending_mass());
+}
+
 // Particle shifting inside the refined box (AdaptiveRefinementParameters::shifting with shift_refined_only): one pass
 // on the disordered block moving at 0.5 m/s shifts most active fine particles (those inside the box, not passive)
 // and no coarse one: the base fluid stays that of the unrefined scene; the passive fine particles of the transition

@@ -46,10 +46,14 @@
 // reported (AdaptiveRefinementCounts::mass_correction). The momentum account (conserve_momentum) then hands the
 // active momentum the pass changed (the status changes and the mass account's rescaling carry momentum) back to the
 // same particles as one velocity shift dP / M_edge, so the active momentum is conserved to round-off too; the largest
-// shift is reported (AdaptiveRefinementCounts::momentum_correction). The model keeps no state a restart needs (levels
-// are smoothing lengths, passive flags and masses are particle fields). Time step: one global step set by the finest
-// particles (SymplecticVerlet), or the coarse levels at twice the finest level's step (LocalSymplecticVerlet,
-// integrators/local_time_stepping.hpp; the pass then runs after each of the finest level's two sub-steps).
+// shift is reported (AdaptiveRefinementCounts::momentum_correction). With mass_account_relaxation tau > 0 the mass
+// account hands back a pending mass gradually (the share 1 - exp(-dt / tau) per pass), so that the active mass plus
+// the pending mass is conserved to round-off: an immediate rescale at fixed density is a source of volume at the
+// moments statuses change, which a wave's motion paces. The only state a restart needs beyond the particle fields
+// (levels are smoothing lengths, passive flags and masses are particle fields) is that pending mass. Time step: one
+// global step set by the finest particles (SymplecticVerlet), or the coarse levels at twice the finest level's step
+// (LocalSymplecticVerlet, integrators/local_time_stepping.hpp; the pass then runs after each of the finest level's two
+// sub-steps).
 //
 // Walls: a box that comes within a kernel support of a wall needs wall particles at its own spacing there (the scene
 // adds them beside the coarse ones; each resolution sees only its own); populate() checks it. Couplings: the porous
@@ -97,6 +101,18 @@ struct AdaptiveRefinementParameters {
   /// Whether each pass also hands the active momentum it changed back to the active particles near the box edges,
   /// as one velocity shift dP / M_edge, so that the active momentum is conserved to round-off too.
   bool conserve_momentum{true};
+  /// Whether the accounts hand the mass and momentum a pass changed to every active fluid particle (one relative mass
+  /// change and one velocity shift for all) instead of those near the box edges. A mass rescale at fixed density
+  /// changes a particle's volume: near the edges it is a local source of volume, timed by the status changes, that a
+  /// wave's own motion paces; spread over all the fluid it raises the level uniformly.
+  bool account_over_all_fluid{false};
+  /// Relaxation time tau of the mass account, s, >= 0. 0: each pass hands back at once the mass it changed. > 0: the
+  /// changes go to a pending mass, of which each pass hands back the share 1 - exp(-dt / tau) (dt since the last
+  /// pass), so the active mass plus the pending mass is conserved to round-off and the pending mass stays of the
+  /// order of the changes over tau. A status change comes at a phase of a wave's orbital motion (with
+  /// status_hysteresis, once per excursion), so an immediate rescale is a volume source paced by the wave;
+  /// relaxed over several periods it is not (docs/variable-resolution.md, session 24).
+  T mass_account_relaxation{0};
   /// Whether a passive particle is interpolated from the active particles of its own level too (h_ab = h_a), not
   /// only from those of the other levels: near a box edge the other level is active on one side only, its own on the
   /// other, so the stencil is two-sided.
@@ -132,6 +148,8 @@ struct AdaptiveRefinementParameters {
     require_in_range("AdaptiveRefinementParameters::smoothing_ratio (h/dp)", smoothing_ratio, T(0.5), T(3));
     require_in_range("AdaptiveRefinementParameters::occupied_fraction", occupied_fraction, T(0.25), T(1));
     require_in_range("AdaptiveRefinementParameters::status_hysteresis (base spacings)", status_hysteresis, T(0), T(1));
+    require_in_range("AdaptiveRefinementParameters::mass_account_relaxation (tau, s)", mass_account_relaxation, T(0),
+                     T(1e6));
     if (!(bunched_fraction >= T(0.1) && bunched_fraction < occupied_fraction))
       throw InputError(
           fmt::format("AdaptiveRefinementParameters::bunched_fraction = {} is invalid: valid range is [0.1, {}) (below "
@@ -152,6 +170,9 @@ struct AdaptiveRefinementCounts {
   double mass_correction{0};
   /// Largest velocity shift of the momentum account, |dP| / M_edge, m/s (0 without conserve_momentum).
   double momentum_correction{0};
+  /// Largest pending mass of a relaxed mass account (mass_account_relaxation > 0) over the active mass, after the
+  /// pass (0 without it).
+  double pending_mass{0};
 };
 
 /// Adaptive particle refinement with overlapping resolutions (see the header comment). A ParticleModel: it adds no
@@ -164,7 +185,6 @@ class AdaptiveRefinement {
   using T = typename System::scalar_type;
   using Vector = Vec<Dim, T>;
   using Box = RefinementBox<Dim, T>;
-  static constexpr bool checkpoint_stateless = true;
 
   /// Throws InputError for invalid parameters, a box outside the domain or of an invalid level, boxes of different
   /// levels that overlap without nesting, and a transition zone narrower than the kernel support of the finest
@@ -224,6 +244,21 @@ class AdaptiveRefinement {
       if (c.created == 0 && level >= max_box_level()) break;
     }
     check_walls(system);
+  }
+
+  /// The mass a relaxed mass account has still to hand back (mass_account_relaxation > 0), kg (per unit depth in 2D).
+  T pending_mass() const noexcept { return pending_mass_; }
+
+  // ---- checkpoint (io/checkpoint.hpp): the relaxed mass account's pending mass and the time of the last pass ----
+  template <class Writer>
+  void save_checkpoint(Writer& w) const {
+    w.write("adaptive_refinement.pending_mass", pending_mass_);
+    w.write("adaptive_refinement.last_pass_time", last_pass_time_);
+  }
+  template <class Reader>
+  void load_checkpoint(Reader& r) {
+    r.read("adaptive_refinement.pending_mass", pending_mass_);
+    r.read("adaptive_refinement.last_pass_time", last_pass_time_);
   }
 
   const AdaptiveRefinementCounts& last_counts() const noexcept { return last_; }
@@ -304,6 +339,7 @@ class AdaptiveRefinement {
     total_.uninterpolated += c.uninterpolated;
     total_.mass_correction = std::max(total_.mass_correction, c.mass_correction);
     total_.momentum_correction = std::max(total_.momentum_correction, c.momentum_correction);
+    total_.pending_mass = std::max(total_.pending_mass, c.pending_mass);
   }
 
   // Whether x lies within transition_width of a box edge (on either side): the band where statuses change.
@@ -315,20 +351,33 @@ class AdaptiveRefinement {
   // changed, the particles that became passive or active carrying them, go back to the active particles near the
   // box edges: each mass scaled by 1 + dM / M_edge, then one velocity shift dP / M_edge for the momentum still
   // missing (the changes' and the rescaling's).
-  void balance(System& system, const std::pair<T, Vector>& before, AdaptiveRefinementCounts& counts) {
+  void balance(System& system, const std::pair<T, Vector>& before, T time, AdaptiveRefinementCounts& counts) {
     auto& p = system.particles();
     const auto [mass, momentum] = active_mass_momentum(system);
-    const T mass_change = params_.conserve_mass ? before.first - mass : T(0);
+    T mass_change = params_.conserve_mass ? before.first - mass : T(0);
+    if (params_.conserve_mass && params_.mass_account_relaxation > T(0)) {
+      // relaxed: this pass's change joins the pending mass, of which the share 1 - exp(-dt / tau) is handed back
+      pending_mass_ += mass_change;
+      const T dt = std::max(time - last_pass_time_, T(0));
+      last_pass_time_ = time;
+      mass_change = pending_mass_ * -std::expm1(-dt / params_.mass_account_relaxation);
+      pending_mass_ -= mass_change;
+      counts.pending_mass = std::abs(static_cast<double>(pending_mass_ / mass));
+    }
     Vector momentum_change = before.second - momentum;
     if (mass_change == T(0) && (!params_.conserve_momentum || momentum_change.squaredNorm() == T(0))) return;
     edge_.clear();
     T band = T(0);
     for (std::size_t a = 0; a < p.size(); ++a) {
-      if (p.kind[a] != Kind::fluid || p.passive[a] || !near_box_edge(p.position[a])) continue;
+      if (p.kind[a] != Kind::fluid || p.passive[a]) continue;
+      if (!params_.account_over_all_fluid && !near_box_edge(p.position[a])) continue;
       edge_.push_back(a);
       band += p.mass[a];
     }
-    if (!(band > T(0))) return;
+    if (!(band > T(0))) {
+      if (params_.mass_account_relaxation > T(0)) pending_mass_ += mass_change;  // kept for a later pass
+      return;
+    }
     if (mass_change != T(0)) {
       const T correction = mass_change / band;
       for (std::size_t a : edge_) {
@@ -494,7 +543,7 @@ class AdaptiveRefinement {
       });
     }
     interpolate_passive(system, counts);
-    if (account) balance(system, before, counts);
+    if (account) balance(system, before, time, counts);
     return counts;
   }
 
@@ -640,6 +689,8 @@ class AdaptiveRefinement {
   AdaptiveRefinementParameters<T> params_;
   ParticleShifting<System> shifter_;
   AdaptiveRefinementCounts last_{}, total_{};
+  T pending_mass_{0};                        // the relaxed mass account's mass still to hand back
+  T last_pass_time_{0};                      // time of the last pass (the relaxed mass account's dt)
   std::vector<int> level_;                   // per slot of the pass: level
   std::vector<std::uint8_t> missing_;        // per slot: passive without an active neighbour of another level
   std::vector<std::uint8_t> leaving_;        // per slot of the pass: 1 if removed in it

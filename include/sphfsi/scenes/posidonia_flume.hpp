@@ -78,6 +78,8 @@ struct PlantRefinement {
   bool shift_passive{true};     ///< with shifting: the passive fine particles (transition zone) are shifted too
   bool limit_fit{false};        ///< AdaptiveRefinementParameters::limit_fit (the passive fit within its data's range)
   T status_hysteresis{T(0)};    ///< AdaptiveRefinementParameters::status_hysteresis, base spacings, [0, 1]
+  T account_relaxation{T(0)};   ///< AdaptiveRefinementParameters::mass_account_relaxation, s, >= 0
+  bool momentum_account{true};  ///< AdaptiveRefinementParameters::conserve_momentum
 };
 
 /// The Posidonia flume: waves, resolution, plants and blade model (lengths in m).
@@ -203,6 +205,8 @@ struct PosidoniaFlume {
     a.shifting.include_passive = refinement.shift_passive;
     a.limit_fit = refinement.limit_fit;
     a.status_hysteresis = refinement.status_hysteresis;
+    a.mass_account_relaxation = refinement.account_relaxation;
+    a.conserve_momentum = refinement.momentum_account;
     return a;
   }
   /// The real blade as a line of rod nodes (rod, drag), not a continuum of particle rows (scaled, equivalent).
