@@ -811,6 +811,40 @@ TEST_CASE("adaptive refinement: the mass account conserves the active mass to ro
   }
 }
 
+// account_over_all_fluid: the mass account hands its changes to every active fluid particle. The block drifts as above;
+// the active mass is kept to round-off either way, and a coarse particle that stays far from the box (x < 0.058 m at
+// the end, the band starts at 0.06 m) keeps its nominal mass with the edge account and takes a share with this one.
+TEST_CASE("adaptive refinement: the mass account over all the fluid keeps the active mass and reaches every particle",
+          "[refinement][apr]") {
+  for (const bool everywhere : {false, true}) {
+    AprBlock block;
+    block.params.conserve_momentum = false;
+    block.params.account_over_all_fluid = everywhere;
+    auto& p = block.system.particles();
+    block.disorder();
+    for (std::size_t i = 0; i < p.size(); ++i) p.velocity[i] = V2(0.5, 0);
+    const double mass0 = fluid_totals(p).mass, nominal = 1000 * AprBlock::dp * AprBlock::dp;
+    Apr apr(block.system.domain(), block.boxes, block.params);
+    apr.populate(block.system);
+    double worst_mass = 0;
+    block.drift(apr, 0.2 * AprBlock::dp / 0.5, [&] {
+      worst_mass = std::max(worst_mass, std::abs(apr.active_mass_momentum(block.system).first - mass0) / mass0);
+    });
+    double far_change = 0;
+    std::size_t far = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      if (p.kind[i] != Kind::fluid || p.passive[i] || p.position[i][0] > 0.058) continue;
+      far_change = std::max(far_change, std::abs(p.mass[i] - nominal) / nominal);
+      ++far;
+    }
+    INFO("over all fluid " << everywhere << ": " << far << " far particles, largest mass change " << far_change);
+    REQUIRE(far > 20);
+    CHECK(worst_mass <= 1e-12);
+    if (everywhere) CHECK(far_change > 1e-9);
+    else CHECK(far_change == 0);
+  }
+}
+
 // The relaxed mass account (mass_account_relaxation tau = 5 passes): the block drifts through the box as above, then
 // stands still for 20 passes (no status changes). The active mass plus the pending mass stays that of the block to
 // round-off after every pass; during the drift the pending mass is not zero (the account is relaxed, not immediate);
