@@ -142,7 +142,8 @@ scenes::PosidoniaFlume<T> converted(const scenes::PosidoniaFlume<double>& s) {
                   s.refinement.limit_fit,
                   T(s.refinement.status_hysteresis),
                   T(s.refinement.account_relaxation),
-                  s.refinement.momentum_account};
+                  s.refinement.momentum_account,
+                  s.refinement.mass_account};
   return c;
 }
 
@@ -770,6 +771,7 @@ int main(int argc, char** argv) try {
       cli.get_number("account-relaxation", 0, "refinement: relaxation time of the mass account, s (0: at once), >= 0");
   s.refinement.momentum_account =
       cli.get_switch("momentum-account", true, "refinement: the momentum account: on | off");
+  s.refinement.mass_account = cli.get_switch("mass-account", true, "refinement: the mass account: on | off");
   o.local_steps = cli.get_switch("local-steps", false,
                                  "refinement: local time stepping, the coarse fluid at twice the fine step: on | off");
   o.uniform_viscosity = cli.get_switch(

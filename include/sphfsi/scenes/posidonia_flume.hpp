@@ -80,6 +80,7 @@ struct PlantRefinement {
   T status_hysteresis{T(0)};    ///< AdaptiveRefinementParameters::status_hysteresis, base spacings, [0, 1]
   T account_relaxation{T(0)};   ///< AdaptiveRefinementParameters::mass_account_relaxation, s, >= 0
   bool momentum_account{true};  ///< AdaptiveRefinementParameters::conserve_momentum
+  bool mass_account{true};      ///< AdaptiveRefinementParameters::conserve_mass
 };
 
 /// The Posidonia flume: waves, resolution, plants and blade model (lengths in m).
@@ -207,6 +208,7 @@ struct PosidoniaFlume {
     a.status_hysteresis = refinement.status_hysteresis;
     a.mass_account_relaxation = refinement.account_relaxation;
     a.conserve_momentum = refinement.momentum_account;
+    a.conserve_mass = refinement.mass_account;
     return a;
   }
   /// The real blade as a line of rod nodes (rod, drag), not a continuum of particle rows (scaled, equivalent).
