@@ -295,8 +295,7 @@ int main(int argc, char** argv) try {
       fmt::print(
           "mass account: largest correction of the edge particles' masses {:.2e} (one pass); momentum account: largest "
           "velocity shift {:.2e} m/s; status changes: {} activated, {} deactivated; largest pending mass of the "
-          "relaxed "
-          "account {:.2e} of the active mass ({:.2e} at the end)\n",
+          "relaxed account {:.2e} of the active mass ({:.2e} at the end)\n",
           refinement.total_counts().mass_correction, refinement.total_counts().momentum_correction,
           refinement.total_counts().activated, refinement.total_counts().deactivated,
           refinement.total_counts().pending_mass, refinement.pending_mass() / fluid_mass());

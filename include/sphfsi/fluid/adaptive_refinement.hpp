@@ -349,8 +349,9 @@ class AdaptiveRefinement {
 
   // The mass and momentum accounts: the active mass (with conserve_mass) and momentum (with conserve_momentum) a pass
   // changed, the particles that became passive or active carrying them, go back to the active particles near the
-  // box edges: each mass scaled by 1 + dM / M_edge, then one velocity shift dP / M_edge for the momentum still
-  // missing (the changes' and the rescaling's).
+  // box edges (all active fluid with account_over_all_fluid): each mass scaled by 1 + dM / M_edge, then one velocity
+  // shift dP / M_edge for the momentum still missing (the changes' and the rescaling's). With mass_account_relaxation,
+  // dM is the share of the pending mass handed back in this pass.
   void balance(System& system, const std::pair<T, Vector>& before, T time, AdaptiveRefinementCounts& counts) {
     auto& p = system.particles();
     const auto [mass, momentum] = active_mass_momentum(system);
