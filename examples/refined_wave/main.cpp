@@ -109,7 +109,8 @@ int main(int argc, char** argv) try {
   const bool limit_fit = cli.get_switch("limit-fit", false,
                                         "apr: the linear fit limited to the range of its neighbours' values: on | off");
   const double hysteresis = cli.get_number(
-      "hysteresis", 0, "apr: a particle keeps its status within this distance of a box edge, base spacings, [0, 1]");
+      "hysteresis", 0,
+      "apr: a particle keeps its status within this distance of a box edge, base spacings, [0, transition - 1.3]");
   const bool account = cli.get_switch("account", true, "apr: the mass account: on | off");
   const bool momentum_account = cli.get_switch("momentum-account", true, "apr: the momentum account: on | off");
   const std::string account_region =

@@ -129,10 +129,11 @@ struct AdaptiveRefinementParameters {
   /// Whether a passive particle's mass is its SPH volume times its density (capped at the nominal mass), else the
   /// nominal mass rho0 s^Dim.
   bool passive_mass_from_volume{true};
-  /// Hysteresis of the active / passive status at a box edge, in base spacings, [0, 1]: within this distance of an
-  /// edge (on either side) a particle keeps its status, so one that oscillates across the edge by less (the orbital
-  /// motion of a wave, the jitter of the particles) does not change it at every pass; it changes once the particle is
-  /// this far past the edge. 0: the status follows the position exactly.
+  /// Hysteresis of the active / passive status at a box edge, in base spacings, [0, transition_width / base_spacing -
+  /// smoothing_ratio] (a fine particle kept active outside its box keeps its support inside the transition zone):
+  /// within this distance of an edge (on either side) a particle keeps its status, so one that oscillates across the
+  /// edge by less (the orbital motion of a wave, the jitter of the particles) does not change it at every pass; it
+  /// changes once the particle is this far past the edge. 0: the status follows the position exactly.
   T status_hysteresis{0};
   /// Particle shifting (fluid/particle_shifting.hpp) of the active particles before each pass; off by default. With
   /// shift_refined_only, on the refined levels only (its max_smoothing_length is then set between levels 0 and 1),
@@ -147,7 +148,12 @@ struct AdaptiveRefinementParameters {
     require_in_open_range("AdaptiveRefinementParameters::split_offset (eps)", split_offset, T(0), T(0.5));
     require_in_range("AdaptiveRefinementParameters::smoothing_ratio (h/dp)", smoothing_ratio, T(0.5), T(3));
     require_in_range("AdaptiveRefinementParameters::occupied_fraction", occupied_fraction, T(0.25), T(1));
-    require_in_range("AdaptiveRefinementParameters::status_hysteresis (base spacings)", status_hysteresis, T(0), T(1));
+    // a fine particle kept active up to the hysteresis outside its box needs its whole support of fine particles
+    // (2 h of level 1 = smoothing_ratio base spacings) inside the transition zone
+    require_in_range(
+        "AdaptiveRefinementParameters::status_hysteresis (base spacings; at most transition_width / "
+        "base_spacing - smoothing_ratio)",
+        status_hysteresis, T(0), std::max(T(0), transition_width / base_spacing - smoothing_ratio));
     require_in_range("AdaptiveRefinementParameters::mass_account_relaxation (tau, s)", mass_account_relaxation, T(0),
                      T(1e6));
     if (!(bunched_fraction >= T(0.1) && bunched_fraction < occupied_fraction))
