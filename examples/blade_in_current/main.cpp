@@ -66,9 +66,10 @@ struct Options {
   T tow_lengths = 8;             // towing distance after the ramp, in blade lengths
   bool velocity_factor = false;  // eps(u_perp) of eq. 23: off, it rectifies the jitter of a light blade
   T normal_damping = 0;          // beta of the coupling's normal dashpot (off: see docs/thin-blades.md)
-  bool visibility = true;        // fluid pairs across the blade do not interact (fluid/thin_structure_visibility.hpp)
-  bool guard = true;             // fluid that steps through the blade is put back (fluid/thin_structure_guard.hpp)
-  T contact_gap = 2;             // resolved blade: height of its contact plane above the bed, in fluid spacings
+  T rod_damping = 0;       // c_d of the rod's damping relative to the carriage, 1/s (flutter only, not the posture)
+  bool visibility = true;  // fluid pairs across the blade do not interact (fluid/thin_structure_visibility.hpp)
+  bool guard = true;       // fluid that steps through the blade is put back (fluid/thin_structure_guard.hpp)
+  T contact_gap = 2;       // resolved blade: height of its contact plane above the bed, in fluid spacings
   // repulsive: the blade is resolved as an obstacle (eqs 17-23) | drag: porous, it exchanges its Morison drag with
   // the fluid (coupling/blade_drag.hpp), the drag law of Luhar & Nepf's model itself: a check of the rod and of the
   // fluid's response, not of the flow around the blade
@@ -194,6 +195,8 @@ CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
   typename Rod::Parameters params;
   params.section = section;
   params.gravity = V::Zero();
+  params.damping = o.rod_damping;
+  params.damping_relative_to_clamp = true;  // towed: damp the motion about the carriage, not the tow itself
   // A porous blade does not move the fluid aside, so its added mass must be the rod's: that of a plate of width b
   // moving normal to itself, rho pi b / 4 per unit length and width. The repulsive blade pushes the fluid and gets
   // its added mass from it.
@@ -374,6 +377,9 @@ int main(int argc, char** argv) try {
                              "(rho l)), [100, 1e6]");
   o.particles_along = cli.get_number("resolution", o.particles_along, "fluid particles along the blade, l / dp");
   o.rod_spacing = cli.get_number("rod-spacing", o.rod_spacing, "rod node spacing / dp, [0.05, 2]");
+  o.rod_damping = cli.get_number("rod-damping", o.rod_damping,
+                                 "the rod's damping rate c_d relative to the towing carriage, 1/s: damps the blade's "
+                                 "flutter, leaves its static posture (0: none), [0, 1000]");
   o.tow_lengths = cli.get_number("tow-lengths", o.tow_lengths, "towing distance after the ramp, blade lengths");
   o.velocity_factor = cli.get_switch("velocity-factor", false, "eps(u_perp) of eq. 23 in the blade coupling: on | off");
   o.normal_damping =
@@ -433,6 +439,7 @@ int main(int argc, char** argv) try {
   require_in_range("--blade-density (kg/m^3)", o.density, T(100), T(1e6));
   require_in_range("--resolution (l / dp)", o.particles_along, T(5), T(200));
   require_in_range("--rod-spacing (ds / dp)", o.rod_spacing, T(0.05), T(2));
+  require_in_range("--rod-damping (c_d, 1/s)", o.rod_damping, T(0), T(1000));
   require_in_range("--depth (blade lengths)", o.depth_lengths, T(1.5), T(20));
   require_in_range("--average-from (blade lengths)", o.average_from, T(0), o.tow_lengths - T(1));
   const auto parse_list = [](const std::string& text) {

@@ -399,6 +399,37 @@ TEST_CASE("elastic rod: a contact plane stops a blade folding onto the bed", "[r
   CHECK_THROWS_WITH(rod.set_contact_plane(V(0, 0), V(0, 0), gap), Catch::Contains("set_contact_plane |normal|"));
 }
 
+TEST_CASE("elastic rod: damping relative to the towing carriage leaves a steadily towed blade straight", "[rod]") {
+  // The cantilever towed normal to itself at a steady U (no fluid, no gravity). Damped relative to the carriage
+  // (damping_relative_to_clamp) it moves rigidly: no deflection. Damped in absolute terms, the damping is a uniform
+  // load q = c_d rho A U that bends it back by the cantilever's q L^4 / (8 EI) (small: 3 % of L, linear theory).
+  const double U = 0.01, c_d = 2 * omega1;
+  for (const bool relative : {true, false}) {
+    System system = make_blade(20);
+    auto& p = system.particles();
+    for (std::size_t i = 0; i < p.size(); ++i) p.velocity[i] = V(0, U);
+    sphfsi::ElasticRodParameters<double> params = weightless(c_d);
+    params.damping_relative_to_clamp = relative;
+    Rod rod(system, 0, blade, params);
+    rod.clamp_base();
+    rod.set_clamp_motion([&](double t) { return V(0, U * t); }, [&](double) { return V(0, U); });
+    const double dt = 200 * rod.solid_time_step();
+    double t = 0;
+    while (t < 40 * 2 * std::numbers::pi / omega1) {
+      rod.advance(system, t, dt);
+      t += dt;
+    }
+    const double deflection = rod.tip_position().y() - U * t;  // the base sits at U t
+    INFO((relative ? "relative" : "absolute") << " damping: tip deflection " << deflection << " m");
+    if (relative) {
+      CHECK(std::abs(deflection) < 1e-12 * L);
+    } else {
+      const double q = c_d * rhoA * U;
+      CHECK(deflection == Approx(-q * L * L * L * L / (8 * EI)).epsilon(0.02));
+    }
+  }
+}
+
 TEST_CASE("elastic rod: nodes added after other particles were removed (ids above the particle count)", "[rod]") {
   // A scene that takes fluid out before adding its blade (an inclined blade cut into a fluid block) leaves ids
   // above the particle count. The rod indexes its nodes by id: it must size that index by the id capacity, not by

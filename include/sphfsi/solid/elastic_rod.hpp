@@ -85,7 +85,11 @@ struct ElasticRodParameters {
   T cfl{T(0.8)};                                 ///< dt = cfl 2 / omega_max (Verlet limit at 1), (0, 1]
   bool sub_cycle{true};                          ///< true: advance() sub-cycles, no limit on the outer step
   T damping{T(0)};                               ///< c_d, mass-proportional damping, 1/s, >= 0 (0: dynamics)
-  T stretch_limit{T(0)};                         ///< BlowUpError above this edge stretch (0: off), else > 1
+  /// Whether the damping acts on the velocity relative to the held nodes' motion (set_clamp_motion) instead of the
+  /// absolute velocity: a towed blade is then damped relative to its carriage, so a steady tow adds no damping force
+  /// and the static posture is the undamped one; only the motion about it (flutter) is damped.
+  bool damping_relative_to_clamp{false};
+  T stretch_limit{T(0)};  ///< BlowUpError above this edge stretch (0: off), else > 1
   /// Extra inertia per unit length and width m_a (kg/m^2, like rho t), e.g. part of the surrounding fluid's added
   /// mass: node i moves with m_i + m_a b D_i under the forces on m_i (elastic, body force, couplings). It
   /// stabilises the explicit coupling of a blade far lighter than the fluid particles it displaces
@@ -266,8 +270,9 @@ class ElasticRod {
 
   // ---- ParticleModel ----
   /// Reads the node state and publishes normal, density, pressure and sound speed of the nodes.
-  void compute_rates(System& system, T /*time*/) {
+  void compute_rates(System& system, T time) {
     gather(system.particles(), false);
+    set_damping_frame(time);
     internal_forces();
     publish(system.particles());
   }
@@ -287,6 +292,7 @@ class ElasticRod {
     const T h = dt / T(n_sub);
     const std::size_t n = ids_.size();
     const Vector g = body_force();
+    set_damping_frame(time);
     internal_forces();
     for (std::size_t s = 0; s < n_sub; ++s) {
       const T t_end = time + T(s + 1) * h;
@@ -309,6 +315,7 @@ class ElasticRod {
           }
         }
       }
+      set_damping_frame(t_end);
       internal_forces();
       for (std::size_t k = 0; k < n; ++k)
         if (!held_[k]) v_[k] += (T(0.5) * h * inertia_ratio_[k]) * (a_int_[k] + a_ext_[k] + g);
@@ -471,6 +478,9 @@ class ElasticRod {
     return std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b));
   }
   static Vector perp(const Vector& e) { return Vector(-e.y(), e.x()); }
+  void set_damping_frame(T t) {
+    damping_frame_ = params_.damping_relative_to_clamp && clamp_velocity_ ? clamp_velocity_(t) : Vector::Zero();
+  }
 
   std::size_t held_count() const {
     std::size_t c = 0;
@@ -507,7 +517,7 @@ class ElasticRod {
       a_int_[j] += f;
       a_int_[j + 1] -= f;
     }
-    for (std::size_t i = 0; i < n; ++i) a_int_[i] = a_int_[i] / mass_[i] - params_.damping * v_[i];
+    for (std::size_t i = 0; i < n; ++i) a_int_[i] = a_int_[i] / mass_[i] - params_.damping * (v_[i] - damping_frame_);
   }
 
   T node_axial_force(std::size_t k) const {
@@ -582,6 +592,7 @@ class ElasticRod {
   T omega_max_{0};                                 // rad/s
   std::size_t sub_steps_{0};
   std::function<Vector(T)> clamp_displacement_, clamp_velocity_;  // motion of the held nodes (empty: at rest)
+  Vector damping_frame_{Vector::Zero()};  // velocity the damping is relative to (damping_relative_to_clamp)
   Vector contact_point_ = Vector::Zero(), contact_normal_ = Vector::UnitY();  // contact plane, m
   T contact_gap_{0};                                                          // m
   bool has_contact_{false};
