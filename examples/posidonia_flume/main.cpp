@@ -766,7 +766,7 @@ int main(int argc, char** argv) try {
       "limit-fit", false, "refinement: the passive particles' linear fit limited to its neighbours' range: on | off");
   s.refinement.status_hysteresis = cli.get_number("hysteresis", 0,
                                                   "refinement: a particle keeps its status within this distance of a "
-                                                  "box edge, base spacings, [0, transition - 1.3]");
+                                                  "box edge, base spacings, [0, transition - h/dp] (h/dp = 2 here)");
   s.refinement.account_relaxation =
       cli.get_number("account-relaxation", 0, "refinement: relaxation time of the mass account, s (0: at once), >= 0");
   s.refinement.momentum_account =

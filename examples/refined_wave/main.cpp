@@ -108,9 +108,9 @@ int main(int argc, char** argv) try {
   const bool linear = cli.get_switch("linear", true, "apr: passive values by a linear MLS fit: on | off");
   const bool limit_fit = cli.get_switch("limit-fit", false,
                                         "apr: the linear fit limited to the range of its neighbours' values: on | off");
-  const double hysteresis = cli.get_number(
-      "hysteresis", 0,
-      "apr: a particle keeps its status within this distance of a box edge, base spacings, [0, transition - 1.3]");
+  const double hysteresis = cli.get_number("hysteresis", 0,
+                                           "apr: a particle keeps its status within this distance of a box edge, base "
+                                           "spacings, [0, transition - h/dp] (h/dp = 2 here)");
   const bool account = cli.get_switch("account", true, "apr: the mass account: on | off");
   const bool momentum_account = cli.get_switch("momentum-account", true, "apr: the momentum account: on | off");
   const std::string account_region =

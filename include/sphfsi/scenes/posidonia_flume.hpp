@@ -77,7 +77,7 @@ struct PlantRefinement {
   T shift_coefficient{T(2)};    ///< A of the shift (fluid/particle_shifting.hpp), (0, 10]
   bool shift_passive{true};     ///< with shifting: the passive fine particles (transition zone) are shifted too
   bool limit_fit{false};        ///< AdaptiveRefinementParameters::limit_fit (the passive fit within its data's range)
-  T status_hysteresis{T(0)};  ///< AdaptiveRefinementParameters::status_hysteresis, base spacings, [0, transition - 1.3]
+  T status_hysteresis{T(0)};    ///< AdaptiveRefinementParameters::status_hysteresis, dp, [0, transition - h/dp]
   T account_relaxation{T(0)};   ///< AdaptiveRefinementParameters::mass_account_relaxation, s, >= 0
   bool momentum_account{true};  ///< AdaptiveRefinementParameters::conserve_momentum
   bool mass_account{true};      ///< AdaptiveRefinementParameters::conserve_mass
