@@ -143,7 +143,8 @@ scenes::PosidoniaFlume<T> converted(const scenes::PosidoniaFlume<double>& s) {
                   T(s.refinement.status_hysteresis),
                   T(s.refinement.account_relaxation),
                   s.refinement.momentum_account,
-                  s.refinement.mass_account};
+                  s.refinement.mass_account,
+                  s.refinement.lagrangian};
   return c;
 }
 
@@ -772,6 +773,10 @@ int main(int argc, char** argv) try {
   s.refinement.momentum_account =
       cli.get_switch("momentum-account", true, "refinement: the momentum account: on | off");
   s.refinement.mass_account = cli.get_switch("mass-account", true, "refinement: the mass account: on | off");
+  s.refinement.lagrangian = cli.get_switch(
+      "lagrangian", false,
+      "refinement: statuses fixed at the start and carried by the particles (the fine patch moves with the water; no "
+      "status changes, children or removals): on | off");
   o.local_steps = cli.get_switch("local-steps", false,
                                  "refinement: local time stepping, the coarse fluid at twice the fine step: on | off");
   o.uniform_viscosity = cli.get_switch(

@@ -111,6 +111,9 @@ int main(int argc, char** argv) try {
   const double hysteresis = cli.get_number("hysteresis", 0,
                                            "apr: a particle keeps its status within this distance of a box edge, base "
                                            "spacings, [0, transition - h/dp] (h/dp = 2 here)");
+  const bool lagrangian = cli.get_switch(
+      "lagrangian", false,
+      "apr: statuses fixed at the start and carried by the particles (the fine patch moves with the water): on | off");
   const bool account = cli.get_switch("account", true, "apr: the mass account: on | off");
   const bool momentum_account = cli.get_switch("momentum-account", true, "apr: the momentum account: on | off");
   const std::string account_region =
@@ -186,6 +189,7 @@ int main(int argc, char** argv) try {
   apr_params.linear_interpolation = linear;
   apr_params.limit_fit = limit_fit;
   apr_params.status_hysteresis = hysteresis;
+  apr_params.lagrangian_statuses = lagrangian;
   apr_params.conserve_mass = account;
   apr_params.conserve_momentum = momentum_account;
   apr_params.account_over_all_fluid = account_region == "all";

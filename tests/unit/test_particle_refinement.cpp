@@ -936,6 +936,67 @@ TEST_CASE("adaptive refinement: particle shifting moves the refined level only",
   }
 }
 
+// Lagrangian statuses (AdaptiveRefinementParameters::lagrangian_statuses): the disordered block of the mass-account
+// test drifts 4 dp through the box in 20 passes. With them, no particle changes status, none is created or removed,
+// every particle keeps the status populate() gave it (by id), and the active mass stays the block's bit for bit
+// (nothing is exchanged, so no account is needed): the refined patch has moved 4 dp with the water. The passive
+// particles are still fitted: a linear field on the active particles of the moved patch is reproduced at every passive
+// particle to round-off. Without the option the same drift changes statuses (the control).
+TEST_CASE("adaptive refinement: Lagrangian statuses move the refined patch with the water", "[refinement][apr]") {
+  for (const bool lagrangian : {true, false}) {
+    AprBlock block;
+    block.params.lagrangian_statuses = lagrangian;
+    auto& p = block.system.particles();
+    const V2 u(0.5, 0);
+    block.disorder();
+    for (std::size_t i = 0; i < p.size(); ++i) p.velocity[i] = u;
+    Apr apr(block.system.domain(), block.boxes, block.params);
+    apr.populate(block.system);
+    const std::size_t count = p.size();
+    const double mass0 = apr.active_mass_momentum(block.system).first;
+    std::vector<std::uint8_t> passive_of_id(p.id_capacity(), 2);
+    double fine_x0 = 0;
+    std::size_t fine = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      passive_of_id[p.id[i]] = p.passive[i];
+      if (!p.passive[i] && apr.level_of(p.smoothing_length[i]) == 1) fine_x0 += p.position[i][0], ++fine;
+    }
+    std::size_t created_or_removed = 0;
+    bool mass_kept = true;
+    const std::size_t changes = block.drift(apr, 0.2 * AprBlock::dp / u[0], [&] {
+      created_or_removed += apr.last_counts().created + apr.last_counts().removed;
+      mass_kept = mass_kept && apr.active_mass_momentum(block.system).first == mass0;
+    });
+    INFO("lagrangian " << lagrangian << ": status changes " << changes << ", created or removed "
+                       << created_or_removed);
+    if (!lagrangian) {
+      CHECK(changes > 0);
+      continue;
+    }
+    CHECK(changes == 0);
+    CHECK(created_or_removed == 0);
+    CHECK(p.size() == count);
+    CHECK(mass_kept);
+    std::size_t kept = 0;
+    double fine_x = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      kept += passive_of_id[p.id[i]] == p.passive[i];
+      if (!p.passive[i] && apr.level_of(p.smoothing_length[i]) == 1) fine_x += p.position[i][0];
+    }
+    CHECK(kept == count);
+    CHECK((fine_x - fine_x0) / double(fine) == Approx(4 * AprBlock::dp).epsilon(1e-12));  // the patch moved 4 dp
+    const auto field = [](const V2& x) { return V2(0.1 + 2 * x[0], -3 * x[1]); };
+    for (std::size_t i = 0; i < p.size(); ++i) p.velocity[i] = p.passive[i] ? V2::Zero() : field(p.position[i]);
+    apr.advance(block.system, 0, 0);  // one pass where the particles are
+    double worst = 0;
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (p.passive[i]) worst = std::max(worst, (p.velocity[i] - field(p.position[i])).norm());
+    INFO("largest error of the passive fit in the moved patch " << worst << " m/s");
+    CHECK(apr.last_counts().uninterpolated == 0);
+    CHECK(worst <= 1e-12);
+  }
+}
+
 // Status hysteresis at a box edge (AdaptiveRefinementParameters::status_hysteresis). The block of AprBlock oscillates
 // rigidly by +-0.3 dp along x (20 passes, each moving it 0.6 dp one way, then back): fine particles near the box's
 // vertical edges cross them at every pass, so without hysteresis statuses change at every pass. With a hysteresis of

@@ -38,6 +38,10 @@
 //   populate() creates the children of every particle in and around the boxes once, at the start (those in the box
 //   active, their parents passive).
 //
+// Lagrangian statuses (lagrangian_statuses): after populate() the statuses stay with the particles; a pass only fits
+// the passive values. The refined region is then a patch of water that moves with the flow, with no status changes,
+// children or removals, for oscillatory flows whose particles come back (waves).
+//
 // Conservation: the coarse particles are never created or removed (inside a box they are passive). Mass and
 // momentum are not exchanged pair-wise between resolutions: a particle that becomes active brings the mass it had as
 // a passive one, one that becomes passive or is removed takes its mass away. The mass account (conserve_mass) hands
@@ -135,6 +139,15 @@ struct AdaptiveRefinementParameters {
   /// edge by less (the orbital motion of a wave, the jitter of the particles) does not change it at every pass; it
   /// changes once the particle is this far past the edge. 0: the status follows the position exactly.
   T status_hysteresis{0};
+  /// Whether the statuses populate() gave are carried by the particles from then on (Lagrangian statuses): after
+  /// populate() a pass changes no status, creates no child and removes no particle; it only fits the passive
+  /// particles' values. The refined region is then a patch of water that moves with the flow (the particles of each
+  /// resolution stay where they started, as the fixed-mass particles of Omidvar, Stansby & Rogers 2012, Int. J.
+  /// Numer. Meth. Fluids 68:686, stay around a body in waves), and the resolutions exchange nothing but the passive
+  /// fits: the active mass is constant exactly and the accounts have nothing to do. For oscillatory flows (waves),
+  /// whose particles come back to where they were; the patch drifts with the mean flow (Stokes drift, streaming),
+  /// which must stay well below the distance from the box edges to what needs the fine fluid.
+  bool lagrangian_statuses{false};
   /// Particle shifting (fluid/particle_shifting.hpp) of the active particles before each pass; off by default. With
   /// shift_refined_only, on the refined levels only (its max_smoothing_length is then set between levels 0 and 1),
   /// so the base fluid stays that of the uniform scene.
@@ -410,6 +423,10 @@ class AdaptiveRefinement {
     auto& p = system.particles();
     const std::size_t n = p.size();
     AdaptiveRefinementCounts counts;
+    if (params_.lagrangian_statuses && initial_level < 0) {  // the statuses move with the particles: fits only
+      interpolate_passive(system, counts);
+      return counts;
+    }
     const bool account = initial_level < 0 && (params_.conserve_mass || params_.conserve_momentum);
     const auto before = account ? active_mass_momentum(system) : std::pair{T(0), Vector::Zero().eval()};
     // 1. Statuses; particles finer than every box within transition_width of them are removed.

@@ -81,6 +81,8 @@ struct PlantRefinement {
   T account_relaxation{T(0)};   ///< AdaptiveRefinementParameters::mass_account_relaxation, s, >= 0
   bool momentum_account{true};  ///< AdaptiveRefinementParameters::conserve_momentum
   bool mass_account{true};      ///< AdaptiveRefinementParameters::conserve_mass
+  /// AdaptiveRefinementParameters::lagrangian_statuses: the fine patch moves with the water, no status changes
+  bool lagrangian{false};
 };
 
 /// The Posidonia flume: waves, resolution, plants and blade model (lengths in m).
@@ -209,6 +211,7 @@ struct PosidoniaFlume {
     a.mass_account_relaxation = refinement.account_relaxation;
     a.conserve_momentum = refinement.momentum_account;
     a.conserve_mass = refinement.mass_account;
+    a.lagrangian_statuses = refinement.lagrangian;
     return a;
   }
   /// The real blade as a line of rod nodes (rod, drag), not a continuum of particle rows (scaled, equivalent).
