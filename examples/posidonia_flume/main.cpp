@@ -353,15 +353,28 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
     const auto c = sim.template model<2>().total_counts();
     std::size_t active = 0, passive = 0, fine = 0;
     const auto& p = system.particles();
+    // where the active fine fluid is at the end (with --lagrangian on the patch moves with the water)
+    double fine_x0 = std::numeric_limits<double>::infinity(), fine_x1 = -fine_x0, fine_z1 = -fine_x0;
     for (std::size_t i = 0; i < p.size(); ++i)
       if (p.kind[i] == Kind::fluid) {
         (p.passive[i] ? passive : active) += 1;
-        fine += sim.template model<2>().level_of(p.smoothing_length[i]) > 0 ? 1 : 0;
+        const bool is_fine = sim.template model<2>().level_of(p.smoothing_length[i]) > 0;
+        fine += is_fine ? 1 : 0;
+        if (is_fine && !p.passive[i]) {
+          fine_x0 = std::min(fine_x0, double(p.position[i][0]));
+          fine_x1 = std::max(fine_x1, double(p.position[i][0]));
+          fine_z1 = std::max(fine_z1, double(p.position[i][1]));
+        }
       }
     fmt::print(
         "refinement: {} fluid particles at the end ({} active, {} passive, {} fine); {} children created, {} removed; "
         "largest mass-account correction {:.2e}, momentum-account velocity shift {:.2e} m/s\n",
         active + passive, active, passive, fine, c.created, c.removed, c.mass_correction, c.momentum_correction);
+    const auto box = scene.refinement_boxes().front();
+    fmt::print(
+        "refinement: active fine fluid at the end over x {:.4f} to {:.4f} m, up to z = {:.4f} m (the box: x "
+        "{:.4f} to {:.4f} m, up to z = {:.4f} m)\n",
+        fine_x0, fine_x1, fine_z1, double(box.lower[0]), double(box.upper[0]), double(box.upper[1]));
   }
 
   // zero up-crossing heights once the full-amplitude waves have reached each gauge
