@@ -144,7 +144,8 @@ scenes::PosidoniaFlume<T> converted(const scenes::PosidoniaFlume<double>& s) {
                   T(s.refinement.account_relaxation),
                   s.refinement.momentum_account,
                   s.refinement.mass_account,
-                  s.refinement.lagrangian};
+                  s.refinement.lagrangian,
+                  s.refinement.follow_flow};
   return c;
 }
 
@@ -371,6 +372,8 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
         "largest mass-account correction {:.2e}, momentum-account velocity shift {:.2e} m/s\n",
         active + passive, active, passive, fine, c.created, c.removed, c.mass_correction, c.momentum_correction);
     const auto box = scene.refinement_boxes().front();
+    fmt::print("refinement: the box moved {:.4f} m along x with the water\n",
+               double(sim.template model<2>().box_displacement()));
     fmt::print(
         "refinement: active fine fluid at the end over x {:.4f} to {:.4f} m, up to z = {:.4f} m (the box: x "
         "{:.4f} to {:.4f} m, up to z = {:.4f} m)\n",
@@ -790,6 +793,10 @@ int main(int argc, char** argv) try {
       "lagrangian", false,
       "refinement: statuses fixed at the start and carried by the particles (the fine patch moves with the water; no "
       "status changes, children or removals): on | off");
+  s.refinement.follow_flow = cli.get_switch(
+      "follow-flow", false,
+      "refinement: the box moves along x with the mean velocity of the fine water in it (at most transition - h/dp "
+      "base spacings): on | off");
   o.local_steps = cli.get_switch("local-steps", false,
                                  "refinement: local time stepping, the coarse fluid at twice the fine step: on | off");
   o.uniform_viscosity = cli.get_switch(

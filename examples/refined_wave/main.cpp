@@ -114,6 +114,10 @@ int main(int argc, char** argv) try {
   const bool lagrangian = cli.get_switch(
       "lagrangian", false,
       "apr: statuses fixed at the start and carried by the particles (the fine patch moves with the water): on | off");
+  const bool follow_flow = cli.get_switch(
+      "follow-flow", false,
+      "apr: the box moves along x with the mean velocity of the fine water in it (at most transition - h/dp base "
+      "spacings): on | off");
   const bool account = cli.get_switch("account", true, "apr: the mass account: on | off");
   const bool momentum_account = cli.get_switch("momentum-account", true, "apr: the momentum account: on | off");
   const std::string account_region =
@@ -190,6 +194,7 @@ int main(int argc, char** argv) try {
   apr_params.limit_fit = limit_fit;
   apr_params.status_hysteresis = hysteresis;
   apr_params.lagrangian_statuses = lagrangian;
+  apr_params.boxes_follow_flow = follow_flow;
   apr_params.conserve_mass = account;
   apr_params.conserve_momentum = momentum_account;
   apr_params.account_over_all_fluid = account_region == "all";

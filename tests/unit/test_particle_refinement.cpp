@@ -997,6 +997,50 @@ TEST_CASE("adaptive refinement: Lagrangian statuses move the refined patch with 
   }
 }
 
+// Boxes that follow the flow (AdaptiveRefinementParameters::boxes_follow_flow): the block of AprBlock, with a 6 dp
+// transition zone (the shift is held within 6 dp - the level-1 support 1.3 dp = 4.7 dp), drifts rigidly at 0.5 m/s.
+// Over the first 4 dp the box moves with it, exactly as far, and no particle changes status, is created or removed.
+// Over the next 4 dp the box stops at 4.7 dp: particles cross its edges again, and the mass account keeps the active
+// mass. Without the option the first 4 dp already change statuses (the control). The displacement survives a
+// checkpoint.
+TEST_CASE("adaptive refinement: boxes that follow the flow move with the water", "[refinement][apr][io]") {
+  for (const bool follow : {true, false}) {
+    AprBlock block;
+    block.params.transition_width = 6 * AprBlock::dp;
+    block.params.boxes_follow_flow = follow;
+    auto& p = block.system.particles();
+    for (std::size_t i = 0; i < p.size(); ++i) p.velocity[i] = V2(0.5, 0);
+    Apr apr(block.system.domain(), block.boxes, block.params);
+    apr.populate(block.system);
+    const double mass0 = apr.active_mass_momentum(block.system).first;
+    std::size_t created_or_removed = 0;
+    const auto count = [&] { created_or_removed += apr.last_counts().created + apr.last_counts().removed; };
+    const std::size_t changes = block.drift(apr, 0.2 * AprBlock::dp / 0.5, count);
+    INFO("follow " << follow << ": box displacement " << apr.box_displacement() << " m, status changes " << changes
+                   << ", created or removed " << created_or_removed);
+    if (!follow) {
+      CHECK(changes > 0);
+      CHECK(apr.box_displacement() == 0);
+      continue;
+    }
+    CHECK(apr.box_displacement() == Approx(4 * AprBlock::dp).epsilon(1e-12));
+    CHECK(apr.boxes()[0].lower[0] == Approx(12 * AprBlock::dp).epsilon(1e-12));
+    CHECK(changes == 0);
+    CHECK(created_or_removed == 0);
+    io::CheckpointWriter writer;
+    apr.save_checkpoint(writer);
+    const std::size_t later = block.drift(apr, 0.2 * AprBlock::dp / 0.5, count);
+    INFO("after 8 dp: box displacement " << apr.box_displacement() << " m, status changes " << later);
+    CHECK(apr.box_displacement() == Approx(4.7 * AprBlock::dp).epsilon(1e-12));
+    CHECK(later > 0);
+    CHECK(apr.active_mass_momentum(block.system).first == Approx(mass0).epsilon(1e-12));
+    io::CheckpointReader reader(writer.bytes().data(), writer.bytes().size(), "test");
+    apr.load_checkpoint(reader);
+    CHECK(apr.box_displacement() == Approx(4 * AprBlock::dp).epsilon(1e-12));
+    CHECK(apr.boxes()[0].lower[0] == Approx(12 * AprBlock::dp).epsilon(1e-12));
+  }
+}
+
 // Status hysteresis at a box edge (AdaptiveRefinementParameters::status_hysteresis). The block of AprBlock oscillates
 // rigidly by +-0.3 dp along x (20 passes, each moving it 0.6 dp one way, then back): fine particles near the box's
 // vertical edges cross them at every pass, so without hysteresis statuses change at every pass. With a hysteresis of

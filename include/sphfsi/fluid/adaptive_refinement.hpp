@@ -42,6 +42,9 @@
 // the passive values. The refined region is then a patch of water that moves with the flow, with no status changes,
 // children or removals, for oscillatory flows whose particles come back (waves).
 //
+// Boxes that follow the flow (boxes_follow_flow): the boxes move along x with the mean velocity of the finest active
+// fluid in them, so that a wave's orbital motion carries the edges with the water.
+//
 // Conservation: the coarse particles are never created or removed (inside a box they are passive). Mass and
 // momentum are not exchanged pair-wise between resolutions: a particle that becomes active brings the mass it had as
 // a passive one, one that becomes passive or is removed takes its mass away. The mass account (conserve_mass) hands
@@ -148,6 +151,13 @@ struct AdaptiveRefinementParameters {
   /// whose particles come back to where they were; the patch drifts with the mean flow (Stokes drift, streaming),
   /// which must stay well below the distance from the box edges to what needs the fine fluid.
   bool lagrangian_statuses{false};
+  /// Whether the boxes move with the water along the first axis (x, a flume's direction of propagation): before each
+  /// pass every box is shifted by dt times the mass-weighted mean x-velocity of the active particles of the finest
+  /// level inside the boxes of that level, so that a wave's orbital motion carries the box edges with the water and
+  /// fewer particles cross them. The total shift is held within +-(transition_width - the finest level's kernel
+  /// support): a scene builds its fine walls under a box and its transition zone, so the active fine fluid keeps its
+  /// walls. Along x only, so a box standing on a bed stays on it.
+  bool boxes_follow_flow{false};
   /// Particle shifting (fluid/particle_shifting.hpp) of the active particles before each pass; off by default. With
   /// shift_refined_only, on the refined levels only (its max_smoothing_length is then set between levels 0 and 1),
   /// so the base fluid stays that of the uniform scene.
@@ -216,11 +226,9 @@ class AdaptiveRefinement {
     check.base_spacing = params_.base_spacing;
     check.smoothing_ratio = params_.smoothing_ratio;
     ParticleRefinement<System> boxes_checked(domain, boxes_, check);
-    int finest = 0;
-    for (const Box& b : boxes_) finest = std::max(finest, b.level);
+    const int finest = max_box_level();
     if (finest == 0) return;
-    const T support =
-        T(System::kernel_type::support) * params_.smoothing_ratio * params_.base_spacing / std::pow(T(2), T(finest));
+    const T support = finest_support();
     if (params_.transition_width < support)
       throw InputError(fmt::format(
           "AdaptiveRefinementParameters::transition_width = {} m is too narrow: valid range is >= {} m (the kernel "
@@ -245,6 +253,7 @@ class AdaptiveRefinement {
   T stable_time_step(const System&) const { return std::numeric_limits<T>::infinity(); }
   /// One pass after the step [t, t + dt]; rebuilds the neighbour index if the particle set changed.
   void advance(System& system, T t, T dt) {
+    if (params_.boxes_follow_flow) move_boxes(system, dt);
     if (params_.shifting.enabled) shifter_.shift(system, dt);
     last_ = pass(system, -1, t + dt);
     accumulate(last_);
@@ -265,6 +274,9 @@ class AdaptiveRefinement {
     check_walls(system);
   }
 
+  /// How far the boxes have moved along x with the water (boxes_follow_flow), m.
+  T box_displacement() const noexcept { return box_displacement_; }
+
   /// The mass a relaxed mass account has still to hand back (mass_account_relaxation > 0), kg (per unit depth in 2D).
   T pending_mass() const noexcept { return pending_mass_; }
 
@@ -273,11 +285,16 @@ class AdaptiveRefinement {
   void save_checkpoint(Writer& w) const {
     w.write("adaptive_refinement.pending_mass", pending_mass_);
     w.write("adaptive_refinement.last_pass_time", last_pass_time_);
+    w.write("adaptive_refinement.box_displacement", box_displacement_);
   }
   template <class Reader>
   void load_checkpoint(Reader& r) {
     r.read("adaptive_refinement.pending_mass", pending_mass_);
     r.read("adaptive_refinement.last_pass_time", last_pass_time_);
+    T displacement = T(0);
+    r.read("adaptive_refinement.box_displacement", displacement);
+    shift_boxes(displacement - box_displacement_);  // the boxes as they were when the checkpoint was written
+    box_displacement_ = displacement;
   }
 
   const AdaptiveRefinementCounts& last_counts() const noexcept { return last_; }
@@ -328,6 +345,39 @@ class AdaptiveRefinement {
       sum += kernel.value(std::sqrt(r2), h);
     }
     return sum;
+  }
+
+  // Kernel support of the finest level's particles, m.
+  T finest_support() const {
+    return T(System::kernel_type::support) * params_.smoothing_ratio * params_.base_spacing /
+           std::pow(T(2), T(max_box_level()));
+  }
+
+  void shift_boxes(T shift) {
+    for (Box& b : boxes_) {
+      b.lower[0] += shift;
+      b.upper[0] += shift;
+    }
+  }
+
+  // boxes_follow_flow: every box moves along x by dt times the mass-weighted mean x-velocity of the active particles
+  // of the finest level inside the boxes of that level (one shift for all, so nested boxes stay nested), the total
+  // held within +-(transition_width - finest_support()).
+  void move_boxes(const System& system, T dt) {
+    const auto& p = system.particles();
+    const int finest = max_box_level();
+    T mass = T(0), momentum = T(0);
+    for (std::size_t a = 0; a < p.size(); ++a) {
+      if (p.kind[a] != Kind::fluid || p.passive[a] || level_of_particle(p, a) != finest) continue;
+      if (highest_level(p.position[a], T(0)) != finest) continue;
+      mass += p.mass[a];
+      momentum += p.mass[a] * p.velocity[a][0];
+    }
+    if (!(mass > T(0))) return;
+    const T limit = std::max(T(0), params_.transition_width - finest_support());
+    const T displacement = std::clamp(box_displacement_ + dt * momentum / mass, -limit, limit);
+    shift_boxes(displacement - box_displacement_);
+    box_displacement_ = displacement;
   }
 
   int max_box_level() const {
@@ -715,6 +765,7 @@ class AdaptiveRefinement {
   AdaptiveRefinementCounts last_{}, total_{};
   T pending_mass_{0};                        // the relaxed mass account's mass still to hand back
   T last_pass_time_{0};                      // time of the last pass (the relaxed mass account's dt)
+  T box_displacement_{0};                    // how far the boxes moved along x (boxes_follow_flow), m
   std::vector<int> level_;                   // per slot of the pass: level
   std::vector<std::uint8_t> missing_;        // per slot: passive without an active neighbour of another level
   std::vector<std::uint8_t> leaving_;        // per slot of the pass: 1 if removed in it

@@ -83,6 +83,8 @@ struct PlantRefinement {
   bool mass_account{true};      ///< AdaptiveRefinementParameters::conserve_mass
   /// AdaptiveRefinementParameters::lagrangian_statuses: the fine patch moves with the water, no status changes
   bool lagrangian{false};
+  /// AdaptiveRefinementParameters::boxes_follow_flow: the box moves along x with the fine water in it
+  bool follow_flow{false};
 };
 
 /// The Posidonia flume: waves, resolution, plants and blade model (lengths in m).
@@ -212,6 +214,7 @@ struct PosidoniaFlume {
     a.conserve_momentum = refinement.momentum_account;
     a.conserve_mass = refinement.mass_account;
     a.lagrangian_statuses = refinement.lagrangian;
+    a.boxes_follow_flow = refinement.follow_flow;
     return a;
   }
   /// The real blade as a line of rod nodes (rod, drag), not a continuum of particle rows (scaled, equivalent).
