@@ -149,14 +149,17 @@ struct AdaptiveRefinementParameters {
   /// Numer. Meth. Fluids 68:686, stay around a body in waves), and the resolutions exchange nothing but the passive
   /// fits: the active mass is constant exactly and the accounts have nothing to do. For oscillatory flows (waves),
   /// whose particles come back to where they were; the patch drifts with the mean flow (Stokes drift, streaming),
-  /// which must stay well below the distance from the box edges to what needs the fine fluid.
+  /// which must stay well below the distance from the box edges to what needs the fine fluid. Measured in a wave flume:
+  /// nothing keeps the passive layers ordered, the resolutions mix at the patch edge within a few periods, and the
+  /// wave loses 4-9 % behind the patch (docs/variable-resolution.md, session 26).
   bool lagrangian_statuses{false};
   /// Whether the boxes move with the water along the first axis (x, a flume's direction of propagation): before each
   /// pass every box is shifted by dt times the mass-weighted mean x-velocity of the active particles of the finest
   /// level inside the boxes of that level, so that a wave's orbital motion carries the box edges with the water and
   /// fewer particles cross them. The total shift is held within +-(transition_width - the finest level's kernel
   /// support): a scene builds its fine walls under a box and its transition zone, so the active fine fluid keeps its
-  /// walls. Along x only, so a box standing on a bed stays on it.
+  /// walls. Along x only, so a box standing on a bed stays on it. Measured: a box top in a wave's vertical orbital
+  /// motion still exchanges four fifths of the particles a fixed box does (docs/variable-resolution.md, session 26).
   bool boxes_follow_flow{false};
   /// Particle shifting (fluid/particle_shifting.hpp) of the active particles before each pass; off by default. With
   /// shift_refined_only, on the refined levels only (its max_smoothing_length is then set between levels 0 and 1),
