@@ -372,8 +372,9 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
         "largest mass-account correction {:.2e}, momentum-account velocity shift {:.2e} m/s\n",
         active + passive, active, passive, fine, c.created, c.removed, c.mass_correction, c.momentum_correction);
     const auto box = scene.refinement_boxes().front();
-    fmt::print("refinement: the box moved {:.4f} m along x with the water\n",
-               double(sim.template model<2>().box_displacement()));
+    if (scene.refinement.follow_flow)
+      fmt::print("refinement: the box moved {:.4f} m along x with the water\n",
+                 double(sim.template model<2>().box_displacement()));
     fmt::print(
         "refinement: active fine fluid at the end over x {:.4f} to {:.4f} m, up to z = {:.4f} m (the box: x "
         "{:.4f} to {:.4f} m, up to z = {:.4f} m)\n",
