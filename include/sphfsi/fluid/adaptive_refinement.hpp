@@ -372,7 +372,7 @@ class AdaptiveRefinement {
     T mass = T(0), momentum = T(0);
     for (std::size_t a = 0; a < p.size(); ++a) {
       if (p.kind[a] != Kind::fluid || p.passive[a] || level_of_particle(p, a) != finest) continue;
-      if (highest_level(p.position[a], T(0)) != finest) continue;
+      if (level_inside(p.position[a]) != finest) continue;
       mass += p.mass[a];
       momentum += p.mass[a] * p.velocity[a][0];
     }
