@@ -67,6 +67,9 @@ struct Options {
   bool guard{true};
   // --refine on: the coarse fluid steps at twice the fine step (integrators/local_time_stepping.hpp).
   bool local_steps{false};
+  // --local-steps on: the coarse fluid within this distance (m) of the box's transition zone steps with the fine
+  // level too, so that the time levels meet inside the coarse fluid (Simulation::set_fine_step_regions); < 0: none.
+  double fine_step_margin{-1};
   // --uniform-viscosity on: alpha applies at the plants' smoothing length and scales as h_ref / h elsewhere, so the
   // coarse fluid has the fine fluid's viscosity (FluidParameters::viscosity_reference_smoothing_length).
   bool uniform_viscosity{false};
@@ -220,6 +223,16 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
     fmt::print("refinement box x [{:.3f}, {:.3f}] m, z [{:.3f}, {:.3f}] m at dp / 2 = {:.4f} m, transition {:.3f} m\n",
                double(box.lower[0]), double(box.upper[0]), double(box.lower[1]), double(box.upper[1]),
                double(scene.plant_dp()), double(scene.refinement.transition_spacings * scene.dp()));
+  }
+  if constexpr (Local) {
+    if (o.fine_step_margin >= 0) {  // the box and its transition zone, grown by the margin, bed to wall top
+      const auto box = scene.refinement_boxes().front();
+      const T grow = scene.refinement.transition_spacings * scene.dp() + T(o.fine_step_margin);
+      const Vec<2, T> lower(box.lower[0] - grow, -g.wave.depth), upper(box.upper[0] + grow, T(2) * g.wave.depth);
+      sim.set_fine_step_regions({{lower, upper}});
+      fmt::print("local steps: the fine step over x [{:.3f}, {:.3f}] m (the box, its transition and {:.3f} m)\n",
+                 double(lower[0]), double(upper[0]), o.fine_step_margin);
+    }
   }
   const waves::Wavemaker<T> maker(g.wave);
   sim.set_wall_motion(layout.flume.paddle_body, maker.template piston_motion<2>());
@@ -800,6 +813,10 @@ int main(int argc, char** argv) try {
       "base spacings): on | off");
   o.local_steps = cli.get_switch("local-steps", false,
                                  "refinement: local time stepping, the coarse fluid at twice the fine step: on | off");
+  o.fine_step_margin = cli.get_number(
+      "fine-step-margin", -1,
+      "with --local-steps on: the coarse fluid within this distance (m) of the box's transition zone steps at the "
+      "fine step too, so that the time levels meet inside the coarse fluid (< 0: at the resolution boundary)");
   o.uniform_viscosity = cli.get_switch(
       "uniform-viscosity", false,
       "alpha at the plants' smoothing length, scaled as h_ref / h elsewhere (the same nu, proportional to alpha h c0, "
@@ -827,6 +844,9 @@ int main(int argc, char** argv) try {
         "uniformly fine run through --reference)");
   if (o.local_steps && !s.refinement.enabled)
     throw InputError("--local-steps on: only with --refine on (one resolution has one time level)");
+  if (o.fine_step_margin >= 0 && !o.local_steps)
+    throw InputError(
+        fmt::format("--fine-step-margin {}: only with --local-steps on (valid: < 0 without it)", o.fine_step_margin));
   s.validate();
   if (precision == "float") return run<float>(o);
   if (precision == "double") return run<double>(o);

@@ -11,6 +11,7 @@
 
 #include <cmath>
 #include <limits>
+#include <tuple>
 #include <vector>
 
 using namespace sphfsi;
@@ -207,6 +208,152 @@ TEST_CASE("local time stepping: a still tank with nested boxes (dp, dp/2, dp/4) 
   }
   // The coarse levels (dp, dp / 2) hold most particles: they are stepped half as often.
   CHECK(local.particle_steps <= 0.75 * global.particle_steps);
+}
+
+TEST_CASE("local time stepping: a frozen particle's pairs give their share to its stepping neighbours only",
+          "[local_time_stepping]") {
+  // One resolution, the right half frozen (as a coarse particle outside a fine-step region is in a sub-step that
+  // evaluates the fine level alone). With `mixed` the stepping half gets the rates of a full evaluation, to
+  // round-off, and the frozen half keeps what it had, bit for bit. The control: without `mixed` the stepping
+  // particles beside the frozen ones miss those pairs.
+  tank::TankConfig cfg;
+  cfg.particles_over_depth = 16;
+  cfg.width = 0.5;
+  auto params = tank::fluid_parameters(cfg);
+  params.same_resolution_pairs = true;
+  tank::System system = tank::make_tank(cfg);
+  set_sloshing(system, 0, cfg.width, cfg.depth, 0.2);
+  auto& p = system.particles();
+  WcsphFluid<tank::System> fluid(params);
+  system.update_neighbors(0);
+  system.update_pressure();
+  fluid.compute_rates(system);
+  const std::vector<V2> full_acceleration = p.acceleration;
+  const std::vector<double> full_density_rate = p.density_rate;
+  std::vector<std::uint8_t> frozen(p.size(), 0);
+  for (std::size_t i = 0; i < p.size(); ++i) frozen[i] = p.position[i][0] > 0.5 * cfg.width;
+  auto largest_errors = [&](bool mixed) {
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (frozen[i]) {
+        p.acceleration[i] = V2(1234.5, -678.9);  // sentinels the evaluation must leave alone
+        p.density_rate[i] = 42.0;
+      }
+    fluid.compute_rates(system, &frozen, mixed);
+    double stepping = 0, scale = 0;
+    bool kept = true;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      if (p.kind[i] != Kind::fluid) continue;
+      if (frozen[i]) {
+        kept = kept && p.acceleration[i] == V2(1234.5, -678.9) && p.density_rate[i] == 42.0;
+        continue;
+      }
+      stepping = std::max(stepping, (p.acceleration[i] - full_acceleration[i]).norm());
+      stepping = std::max(stepping, std::abs(p.density_rate[i] - full_density_rate[i]) * cfg.dp());
+      scale = std::max(scale, full_acceleration[i].norm());
+    }
+    return std::tuple{stepping, scale, kept};
+  };
+  const auto [mixed_error, scale, mixed_kept] = largest_errors(true);
+  const auto [unmixed_error, scale_b, unmixed_kept] = largest_errors(false);
+  INFO("largest acceleration " << scale << " m/s^2; stepping half off the full evaluation by " << mixed_error
+                               << " with mixed pairs, " << unmixed_error << " without");
+  CHECK(mixed_kept);
+  CHECK(unmixed_kept);
+  CHECK(mixed_error <= 1e-12 * scale);
+  CHECK(unmixed_error >= 1e-3 * scale);
+}
+
+TEST_CASE("local time stepping: coarse particles in a fine-step region step with the fine level",
+          "[local_time_stepping]") {
+  // The two tanks of the test above (A at dp, B at dp / 2). A region over all of A: both tanks advance as with the
+  // fine step dt / 2, to round-off. A region over A's left half: that half steps at dt / 2 and the right half at dt,
+  // the pairs across the split read the frozen partner at its midpoint; A then stays within the scheme's own step
+  // error (A with dt against A with dt / 2) of the run with dt / 2, and its mass and particle-steps are counted.
+  tank::TankConfig cfg;
+  cfg.particles_over_depth = 8;
+  cfg.width = 0.4;
+  const double dp = cfg.dp(), gap = 0.3;
+  auto fluid = tank::fluid_parameters(cfg);
+  fluid.same_resolution_pairs = true;
+  const double x_b = cfg.width + gap, x_max = x_b + cfg.width;
+  const double dt = 2 * 0.2 * 0.5 * dp * cfg.smoothing_ratio / cfg.sound_speed();
+  auto fixed = [](double step) {
+    TimeStepParameters<double> s;
+    s.fixed_dt = step;
+    return s;
+  };
+  auto make_scene = [&](bool with_a, bool with_b) {
+    tank::System s = make_system(x_max, cfg);
+    if (with_a) add_tank(s, 0, cfg, dp);
+    if (with_b) add_tank(s, x_b, cfg, 0.5 * dp);
+    if (with_a) set_sloshing(s, 0, cfg.width, cfg.depth, 0.2);
+    if (with_b) set_sloshing(s, x_b, x_max, cfg.depth, 0.2);
+    return s;
+  };
+  const int macro_steps = 30;
+  tank::System only_a = make_scene(true, false), a_half_step = make_scene(true, false),
+               only_b = make_scene(false, true);
+  const auto count_a = static_cast<std::uint32_t>(only_a.particles().size());
+  const auto count_b = static_cast<std::uint32_t>(only_b.particles().size());
+  tank::TankSimulation run_a(only_a, fluid, fixed(dt)), run_a_half(a_half_step, fluid, fixed(0.5 * dt)),
+      run_b(only_b, fluid, fixed(0.5 * dt));
+  for (int k = 0; k < macro_steps; ++k) {
+    run_a.step();
+    run_a_half.step();
+    run_a_half.step();
+    run_b.step();
+    run_b.step();
+  }
+  const double step_effect = largest_position_difference(only_a, a_half_step, 0, count_a, 0);
+  const double below = -cfg.depth, above = 2 * cfg.wall_height;
+
+  SECTION("a region over all of A") {
+    tank::System both = make_scene(true, true);
+    LocalTankSimulation local(both, fluid, fixed(dt));
+    local.set_fine_step_regions({{V2(-cfg.depth, below), V2(cfg.width + 0.5 * gap, above)}});
+    for (int k = 0; k < macro_steps; ++k) local.step();
+    CHECK(local.coarse_particle_count() == 0);
+    CHECK(local.particle_steps() == 2.0 * macro_steps * (count_a + count_b));
+    const double error_a = largest_position_difference(both, a_half_step, 0, count_a, 0);
+    const double error_b = largest_position_difference(both, only_b, count_a, count_b, count_a);
+    const double tolerance = 1e-10 * dp;
+    INFO("A " << error_a << " m from its run with dt / 2, B " << error_b
+              << " m from its own; dt against dt / 2 moves A by " << step_effect << " m");
+    CHECK(error_a <= tolerance);
+    CHECK(error_b <= tolerance);
+    CHECK(step_effect >= 100 * tolerance);
+  }
+  SECTION("a region over A's left half") {
+    tank::System both = make_scene(true, true);
+    LocalTankSimulation local(both, fluid, fixed(dt));
+    local.set_fine_step_regions({{V2(-cfg.depth, below), V2(0.5 * cfg.width, above)}});
+    std::size_t fast_a = 0;
+    for (std::size_t i = 0; i < count_a; ++i) fast_a += both.particles().position[i][0] <= 0.5 * cfg.width;
+    local.step();
+    // the levels of the first macro step: B and A's left half fine, A's right half coarse
+    CHECK(local.coarse_particle_count() == count_a - fast_a);
+    CHECK(local.particle_steps() == 2.0 * (count_a + count_b) - double(count_a - fast_a));
+    double mass0 = 0;
+    for (std::size_t i = 0; i < count_a; ++i) mass0 += both.particles().mass[i];
+    for (int k = 1; k < macro_steps; ++k) local.step();
+    const double error_a = largest_position_difference(both, a_half_step, 0, count_a, 0);
+    const double error_b = largest_position_difference(both, only_b, count_a, count_b, count_a);
+    INFO("split A " << error_a << " m from its run with dt / 2; A with dt is " << step_effect << " m from it; B "
+                    << error_b << " m from its own");
+    CHECK(fast_a > 0);
+    CHECK(fast_a < count_a);
+    CHECK(error_a > 0);
+    CHECK(error_a <= 2 * step_effect);
+    CHECK(error_b <= 1e-10 * dp);  // B never meets A: untouched by the split
+  }
+  SECTION("bad regions") {
+    tank::System both = make_scene(true, true);
+    LocalTankSimulation local(both, fluid, fixed(dt));
+    REQUIRE_THROWS_WITH(local.set_fine_step_regions({{V2(0.3, 0), V2(0.1, 1)}}),
+                        Catch::Contains("set_fine_step_regions") && Catch::Contains("lower < upper"));
+    tank::TankSimulation global(only_a, fluid, fixed(dt));
+    REQUIRE_THROWS_WITH(global.set_fine_step_regions({{V2(0, 0), V2(1, 1)}}), Catch::Contains("local-time-stepping"));
+  }
 }
 
 TEST_CASE("local time stepping: bad input gives an InputError naming the parameter and its valid range",

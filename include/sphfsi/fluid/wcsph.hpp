@@ -197,8 +197,10 @@ class WcsphFluid {
   /// `frozen` (one flag per slot, or null): local time stepping (integrators/local_time_stepping.hpp) evaluates only
   /// the particles that take a step now; a frozen slot keeps the rates it has, and its pairs are skipped. It needs
   /// FluidParameters::same_resolution_pairs with the frozen particles one resolution (no pair joins a frozen
-  /// particle to one that is not); the signal speed of a frozen slot is left at zero.
-  void compute_rates(System& system, const std::vector<std::uint8_t>* frozen = nullptr) {
+  /// particle to one that is not); the signal speed of a frozen slot is left at zero. `mixed`: a frozen particle may
+  /// have stepping neighbours of its own resolution (the fine-step regions of Simulation); such a pair adds its
+  /// share to the stepping particle only, read from the frozen one's current state.
+  void compute_rates(System& system, const std::vector<std::uint8_t>* frozen = nullptr, bool mixed = false) {
     auto& p = system.particles();
     const std::size_t n = p.size();
     if (frozen && frozen->size() != n)
@@ -209,6 +211,7 @@ class WcsphFluid {
           "WcsphFluid::compute_rates: frozen particles need FluidParameters::same_resolution_pairs = true (valid: the "
           "resolutions interact only through passive particles, so no pair joins a frozen particle to a stepping one)");
     frozen_ = frozen ? frozen->data() : nullptr;
+    frozen_mixed_ = frozen && mixed;
     signal_speed_.assign(n, T(0));
     pressure_term_.resize(n);
     volume_.resize(n);
@@ -258,6 +261,7 @@ class WcsphFluid {
       }
     });
     frozen_ = nullptr;
+    frozen_mixed_ = false;
   }
 
   /// Stable time step of the last evaluated rates (Monaghan & Kos 1999; SPHysics): min of
@@ -443,8 +447,11 @@ class WcsphFluid {
   void accumulate_particle(System& system, std::size_t a, const Sink& partner) {
     auto& p = system.particles();
     const Kind ka = p.kind[a];
-    if (ka == Kind::solid) return;      // solids: fluid-solid pairs belong to the coupling policies
-    if (frozen_ && frozen_[a]) return;  // keeps its rates (local time stepping): its pairs are all frozen too
+    if (ka == Kind::solid) return;  // solids: fluid-solid pairs belong to the coupling policies
+    // Local time stepping: a frozen slot keeps its rates; its pairs give only their stepping partner's share
+    // (with fine-step regions a frozen particle may have stepping neighbours of its own resolution).
+    const bool frozen_a = frozen_ && frozen_[a];
+    if (frozen_a && !frozen_mixed_) return;  // its pairs are all frozen too
     const auto& kernel = system.kernel();
     const T rho0 = system.eos().reference_density();
     const T c0 = system.eos().reference_sound_speed();
@@ -482,6 +489,8 @@ class WcsphFluid {
       const Kind kb = kind[b];
       const bool fluid_b = kb == Kind::fluid;
       if (kb == Kind::solid || !(fluid_a || fluid_b)) return;  // wall-wall pairs do not interact
+      const bool stepping_b = !(frozen_ && frozen_[b]);
+      if (frozen_a && !stepping_b) return;
       if (same_resolution && std::abs(h_a - p.smoothing_length[b]) > same_h_tolerance * h_a) return;
       if constexpr (Dim == 2) {  // hidden from each other by a thin structure
         if (occluded_ && (visibility_.near(a) || visibility_.near(b)) && visibility_.blocks(a, b, xa, x[b])) return;
@@ -490,13 +499,13 @@ class WcsphFluid {
       if (passive_a && fluid_b && p.passive[b]) {  // both carried (their rates are zeroed): only the time step's
         const T mu = h * vab.dot(dx) * (T(1) / (r * r + T(0.01) * h * h));  // signal speed, as below
         mu_max = std::max(mu_max, std::abs(mu));
-        partner.raise_signal_speed(b, std::abs(mu));
+        if (stepping_b) partner.raise_signal_speed(b, std::abs(mu));
         return;
       }
       if (!dynamic_walls && !(fluid_a && fluid_b)) {  // repulsive wall: pushes the fluid particle only
         if (fluid_a)
           acc += repulsive_force<Dim, T>(dx, vab, p.normal[b], h, c0, xa[up] - water_level, params_.repulsive);
-        else
+        else if (stepping_b)
           partner.add_acceleration(b, repulsive_force<Dim, T>(Vector(-dx), Vector(-vab), p.normal[a], h, c0,
                                                               x[b][up] - water_level, params_.repulsive));
         return;
@@ -529,7 +538,7 @@ class WcsphFluid {
         if (nu > T(0)) acc += (mass[b] * laminar) * vab;
         mu_max = std::max(mu_max, std::abs(mu));
       }
-      if (fluid_b) {
+      if (fluid_b && stepping_b) {
         Vector acc_b =
             difference_form && corrected_[b]
                 ? Vector((vol_a * (pressure[a] - pressure[b]) / rho_b) * (correction_[b] * grad) + (ma * pi_ab) * grad)
@@ -551,11 +560,12 @@ class WcsphFluid {
         if (eps_xsph > T(0)) {
           const T w = eps_xsph * kernel.value(r, h) / (T(0.5) * (rho_a + rho_b));
           xsph -= (mass[b] * w) * vab;
-          partner.add_xsph(b, (ma * w) * vab);
+          if (stepping_b) partner.add_xsph(b, (ma * w) * vab);
         }
       }
-      partner.add_density_rate(b, drho_b);
+      if (stepping_b) partner.add_density_rate(b, drho_b);
     });
+    if (frozen_a) return;
     p.acceleration[a] += acc;
     p.density_rate[a] += drho;
     p.xsph_velocity[a] += xsph;
@@ -574,6 +584,7 @@ class WcsphFluid {
   bool occluded_{false};                   // this evaluation applies the visibility criterion
   bool guarded_{false};                    // this evaluation prepared the thin-structure guard
   const std::uint8_t* frozen_{nullptr};    // during compute_rates: slots that keep their rates (or null)
+  bool frozen_mixed_{false};               // during compute_rates: a frozen slot may pair with a stepping one
 };
 
 }  // namespace sphfsi

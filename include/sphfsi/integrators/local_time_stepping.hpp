@@ -30,6 +30,14 @@
 // passive takes no further rate; one it turned active (Simulation::passive_at_step_start) completes the step from
 // its fitted state at t + dt/2 with dt/2.
 //
+// Fine-step regions (Simulation::set_fine_step_regions): coarse particles that start a macro step inside one step
+// with the finest level. Around a refinement box they keep the coarse fluid that feeds the passive particles on the
+// fine step, so that the resolutions couple as with one global step; the time levels then meet inside the coarse
+// fluid, where a pair joins a frozen particle to a stepping one. In the sub-step that evaluates the finest level
+// alone such a pair gives its share to the stepping particle only, read from the frozen one at its midpoint
+// (WcsphFluid::compute_rates with `mixed`); in the other both take their shares. Momentum across that edge is then
+// exchanged at two times, as in the hierarchical time bins of Springel 2005, not conserved pair by pair.
+//
 // Limits: models' forces on coarse particles are taken from the second evaluation only; solids and couplings belong
 // in the finest level (the porous blades in the refinement box). The coarse particles' signal speeds are those of
 // their last evaluation, kept by Simulation as a level limit (a restart takes them from the saved rates).

@@ -112,6 +112,32 @@ class Simulation {
     expected_speed_ = speed;
   }
 
+  /// Local time stepping: axis-aligned boxes [lower, upper] in which every particle steps with the finest level,
+  /// whatever its smoothing length. Around a refinement box they keep the coarse fluid that meets the fine one
+  /// through passive particles on the fine step, so that the two resolutions couple as with one global step and
+  /// the time levels meet inside the coarse fluid instead (a coarse pair across the region's edge then joins the
+  /// levels: the stepping particle reads its frozen neighbour at that neighbour's midpoint, the hierarchical time
+  /// bins of Springel 2005). A particle's level is fixed for a whole macro step by its position at the step's start.
+  /// An empty list (the default) puts the level boundary at the resolution boundary.
+  void set_fine_step_regions(std::vector<std::pair<Vector, Vector>> boxes) {
+    if constexpr (!local_time_stepping)
+      if (!boxes.empty())
+        throw InputError(
+            "Simulation::set_fine_step_regions: only with a local-time-stepping integrator "
+            "(LocalSymplecticVerlet); with one global step every particle steps at the finest rate");
+    for (const auto& [lower, upper] : boxes)
+      for (int d = 0; d < Dim; ++d)
+        if (!(std::isfinite(lower[d]) && std::isfinite(upper[d]) && lower[d] < upper[d]))
+          throw InputError(
+              fmt::format("Simulation::set_fine_step_regions: box axis {} spans [{}, {}] m (valid: "
+                          "finite bounds with lower < upper)",
+                          d, lower[d], upper[d]));
+    fine_step_regions_ = std::move(boxes);
+    fine_step_by_id_.clear();
+  }
+  /// The boxes of set_fine_step_regions().
+  const std::vector<std::pair<Vector, Vector>>& fine_step_regions() const noexcept { return fine_step_regions_; }
+
   /// Moves all wall particles of `body` rigidly with the given motion (a wavemaker paddle, a piston).
   void set_wall_motion(std::int32_t body, PrescribedMotion<Dim, T> motion) {
     if (!motion.displacement || !motion.velocity)
@@ -134,6 +160,7 @@ class Simulation {
     const T dt = next_time_step();
     const auto n = double(system_.particles().size());
     if constexpr (local_time_stepping) {
+      mark_fine_step_regions();
       update_time_levels();
       particle_steps_ += 2.0 * n - double(coarse_count_);
       const auto& p = system_.particles();
@@ -222,7 +249,7 @@ class Simulation {
     if constexpr (local_time_stepping) {
       update_time_levels();
       freeze_coarse = freeze_coarse && coarse_count_ > 0;
-      fluid_.compute_rates(system_, freeze_coarse ? &coarse_ : nullptr);
+      fluid_.compute_rates(system_, freeze_coarse ? &coarse_ : nullptr, !fine_step_regions_.empty());
       if (freeze_coarse) {  // the models add to the fluid's rates: the frozen ones are kept as they were
         frozen_acceleration_.resize(p.size());
         frozen_xsph_.resize(p.size());
@@ -251,7 +278,8 @@ class Simulation {
   }
 
   /// Local time stepping: marks the coarse time level, one flag per slot (1: a fluid or wall particle whose smoothing
-  /// length exceeds 1.5 times the smallest one of the fluid and walls; solids step with the finest level), and
+  /// length exceeds 1.5 times the smallest one of the fluid and walls and that is outside the fine-step regions at
+  /// the start of the step, set_fine_step_regions(); solids step with the finest level), and
   /// returns the flags. Call it again after anything that re-sorted, added or removed particles. The coarse level
   /// interacts with the finest one through the refinement's passive particles only, so it needs
   /// FluidParameters::same_resolution_pairs.
@@ -265,6 +293,7 @@ class Simulation {
     coarse_count_ = 0;
     for (std::size_t i = 0; i < n; ++i) {
       if (p.kind[i] == Kind::solid || !(p.smoothing_length[i] > T(1.5) * h_min)) continue;
+      if (in_fine_step_region(i)) continue;
       coarse_[i] = 1;
       ++coarse_count_;
     }
@@ -382,6 +411,26 @@ class Simulation {
     if constexpr (requires { model.structure_edges(edges); }) model.structure_edges(edges);
   }
 
+  /// Local time stepping: which particles (by id) start this step inside a fine-step region.
+  void mark_fine_step_regions() {
+    if (fine_step_regions_.empty()) return;
+    const auto& p = system_.particles();
+    fine_step_by_id_.assign(p.id_capacity(), 0);
+    for (std::size_t i = 0; i < p.size(); ++i) fine_step_by_id_[p.id[i]] = inside_fine_step_region(p.position[i]);
+  }
+  bool inside_fine_step_region(const Vector& x) const {
+    for (const auto& [lower, upper] : fine_step_regions_)
+      if ((x.array() >= lower.array()).all() && (x.array() <= upper.array()).all()) return true;
+    return false;
+  }
+  /// The level a particle took at the start of the step (its position now if it was created since).
+  bool in_fine_step_region(std::size_t i) const {
+    if (fine_step_regions_.empty()) return false;
+    const auto id = system_.particles().id[i];
+    if (id < fine_step_by_id_.size()) return fine_step_by_id_[id] != 0;
+    return inside_fine_step_region(system_.particles().position[i]);
+  }
+
   /// Local time stepping: the stability limits of the levels just evaluated (the coarse one only when it was).
   void record_level_steps(bool coarse_evaluated) {
     fine_stable_ = fluid_.stable_time_step(system_, [&](std::size_t a) { return !coarse_[a]; });
@@ -477,6 +526,8 @@ class Simulation {
   bool level_steps_known_{false};
   std::vector<Vector> frozen_acceleration_, frozen_xsph_;
   std::vector<T> frozen_density_rate_;
+  std::vector<std::pair<Vector, Vector>> fine_step_regions_;  // set_fine_step_regions()
+  std::vector<std::uint8_t> fine_step_by_id_;                 // by id: inside a fine-step region at the step's start
   std::function<void(const std::string&)> warn_ = [](const std::string& message) {
     std::fprintf(stderr, "warning: %s\n", message.c_str());
   };
