@@ -556,7 +556,7 @@ bool compare_with_reference(const Options& o, const CaseResult& with) {
   }
   const double saving = reference_steps / with.particle_steps;
   pass = pass && saving >= 2.5;
-  fmt::print("  particle-steps {:.4g}, fine {:.4g}: {:.2f} times fewer (criterion 2.5)\n{}\n", with.particle_steps,
+  fmt::print("  particle-steps {:.4g}, fine {:.4g}: {:.3f} times fewer (criterion 2.5)\n{}\n", with.particle_steps,
              reference_steps, saving, pass ? "PASS" : "FAIL");
   out.write_row({3, 0, with.particle_steps, reference_steps, saving});
   return pass;
