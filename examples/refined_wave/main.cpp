@@ -135,6 +135,10 @@ int main(int argc, char** argv) try {
   const bool shift = cli.get_switch("shift", false, "apr: particle shifting of the fine particles: on | off");
   const bool local_steps = cli.get_switch(
       "local-steps", false, "apr: local time stepping, the coarse level at twice the fine step: on | off");
+  const double fine_step_margin = cli.get_number(
+      "fine-step-margin", -1,
+      "with --local-steps on: the coarse fluid within this distance (m) of the box's transition zone steps at the fine "
+      "step too, so that the time levels meet inside the coarse fluid (< 0: at the resolution boundary)");
   const double shift_coefficient =
       cli.get_number("shift-coefficient", 2, "apr: A of the shift -A h |v| dt grad C, (0, 10]");
   const bool shift_passive =
@@ -213,6 +217,16 @@ int main(int argc, char** argv) try {
     Solver sim(system, fluid, {}, damping, std::move(model));
     auto& refinement = sim.template model<1>();
     if constexpr (adaptive) refinement.populate(system);
+    if constexpr (Solver::local_time_stepping) {
+      if (fine_step_margin >= 0 && !boxes.empty()) {  // the box and its transition zone, grown along x, all depths
+        const T grow = apr_params.transition_width + T(fine_step_margin);
+        const V2 lower(boxes.front().lower[0] - grow, -g.wave.depth);
+        const V2 upper(boxes.front().upper[0] + grow, T(3) * g.wave.depth);
+        sim.set_fine_step_regions({{lower, upper}});
+        fmt::print("local steps: the fine step over x [{:.3f}, {:.3f}] m (the box, its transition and {:.3f} m)\n",
+                   double(lower[0]), double(upper[0]), fine_step_margin);
+      }
+    }
     // A fluid particle's level, and whether it is part of the integrated fluid (apr: the active particles).
     auto level_of = [&](std::size_t i) {
       if constexpr (adaptive) return refinement.level_of(system.particles().smoothing_length[i]);
@@ -387,6 +401,9 @@ int main(int argc, char** argv) try {
   };
   if (apr && local_steps) return run(Adaptive(system.domain(), boxes, apr_params), LocalSymplecticVerlet{});
   if (local_steps) throw InputError("--local-steps on: only with --method apr (split and merge pair the two sizes)");
+  if (fine_step_margin >= 0 && !local_steps)
+    throw InputError(
+        fmt::format("--fine-step-margin {}: only with --local-steps on (valid: < 0 without it)", fine_step_margin));
   if (apr) return run(Adaptive(system.domain(), boxes, apr_params), SymplecticVerlet{});
   return run(Refinement(system.domain(), boxes, params), SymplecticVerlet{});
 } catch (const std::exception& e) {
