@@ -64,6 +64,40 @@ double largest_position_difference(const tank::System& a, const tank::System& b,
   return largest;
 }
 
+// Tank A at dp and tank B at dp / 2, side by side without contact (with same_resolution_pairs neither sees the
+// other), both sloshing. dt is the macro step: the fine tank's acoustic limit is half the coarse one's, so dt / 2 is
+// at CFL 0.2 of the fine tank.
+struct TwoTanks {
+  tank::TankConfig cfg = [] {
+    tank::TankConfig c;
+    c.particles_over_depth = 8;
+    c.width = 0.4;
+    return c;
+  }();
+  double dp = cfg.dp(), gap = 0.3, x_b = cfg.width + gap, x_max = x_b + cfg.width;
+  double dt = 2 * 0.2 * 0.5 * dp * cfg.smoothing_ratio / cfg.sound_speed();
+  FluidParameters<2, double> fluid = [this] {
+    auto f = tank::fluid_parameters(cfg);
+    f.same_resolution_pairs = true;
+    return f;
+  }();
+
+  tank::System scene(bool with_a, bool with_b) const {
+    tank::System s = make_system(x_max, cfg);
+    if (with_a) add_tank(s, 0, cfg, dp);
+    if (with_b) add_tank(s, x_b, cfg, 0.5 * dp);
+    if (with_a) set_sloshing(s, 0, cfg.width, cfg.depth, 0.2);
+    if (with_b) set_sloshing(s, x_b, x_max, cfg.depth, 0.2);
+    return s;
+  }
+};
+
+TimeStepParameters<double> fixed_step(double dt) {
+  TimeStepParameters<double> s;
+  s.fixed_dt = dt;
+  return s;
+}
+
 }  // namespace
 
 TEST_CASE("local time stepping: with one smoothing length a macro step is two symplectic steps, bit for bit",
@@ -101,34 +135,15 @@ TEST_CASE("local time stepping: with one smoothing length a macro step is two sy
 
 TEST_CASE("local time stepping: a coarse and a fine tank in one scene each advance as with their own step",
           "[local_time_stepping]") {
-  // Tank A at dp, tank B at dp / 2, side by side without contact; with same_resolution_pairs neither sees the other.
-  // Under local time stepping with the macro step dt, A must follow a run of A alone with dt and B a run of B alone
-  // with dt / 2, to round-off (the neighbour sums are added in another order).
-  tank::TankConfig cfg;
-  cfg.particles_over_depth = 8;
-  cfg.width = 0.4;
-  const double dp = cfg.dp(), gap = 0.3;
-  auto fluid = tank::fluid_parameters(cfg);
-  fluid.same_resolution_pairs = true;
-  const double x_b = cfg.width + gap, x_max = x_b + cfg.width;
-  tank::System both = make_system(x_max, cfg), only_a = make_system(x_max, cfg), only_b = make_system(x_max, cfg),
-               a_half_step = make_system(x_max, cfg);
-  add_tank(both, 0, cfg, dp);
-  const auto count_a = static_cast<std::uint32_t>(both.particles().size());
-  add_tank(both, x_b, cfg, 0.5 * dp);
-  const auto count_b = static_cast<std::uint32_t>(both.particles().size()) - count_a;
-  add_tank(only_a, 0, cfg, dp);
-  add_tank(a_half_step, 0, cfg, dp);
-  add_tank(only_b, x_b, cfg, 0.5 * dp);
-  for (auto* s : {&both, &only_a, &a_half_step}) set_sloshing(*s, 0, cfg.width, cfg.depth, 0.2);
-  for (auto* s : {&both, &only_b}) set_sloshing(*s, x_b, x_max, cfg.depth, 0.2);
-  // The fine tank's acoustic limit is half the coarse one's: dt / 2 at CFL 0.2 of the fine tank.
-  const double dt = 2 * 0.2 * 0.5 * dp * cfg.smoothing_ratio / cfg.sound_speed();
-  auto fixed = [](double step) {
-    TimeStepParameters<double> s;
-    s.fixed_dt = step;
-    return s;
-  };
+  // TwoTanks: A at dp, B at dp / 2. Under local time stepping with the macro step dt, A must follow a run of A alone
+  // with dt and B a run of B alone with dt / 2, to round-off (the neighbour sums are added in another order).
+  const TwoTanks tanks;
+  const auto& [cfg, dp, gap, x_b, x_max, dt, fluid] = tanks;
+  tank::System both = tanks.scene(true, true), only_a = tanks.scene(true, false), only_b = tanks.scene(false, true),
+               a_half_step = tanks.scene(true, false);
+  const auto count_a = static_cast<std::uint32_t>(only_a.particles().size());
+  const auto count_b = static_cast<std::uint32_t>(only_b.particles().size());
+  auto fixed = fixed_step;
   const int macro_steps = 30;
   LocalTankSimulation local(both, fluid, fixed(dt));
   tank::TankSimulation run_a(only_a, fluid, fixed(dt)), run_b(only_b, fluid, fixed(0.5 * dt)),
@@ -269,27 +284,10 @@ TEST_CASE("local time stepping: coarse particles in a fine-step region step with
   // fine step dt / 2, to round-off. A region over A's left half: that half steps at dt / 2 and the right half at dt,
   // the pairs across the split read the frozen partner at its midpoint; A then stays within the scheme's own step
   // error (A with dt against A with dt / 2) of the run with dt / 2, and its mass and particle-steps are counted.
-  tank::TankConfig cfg;
-  cfg.particles_over_depth = 8;
-  cfg.width = 0.4;
-  const double dp = cfg.dp(), gap = 0.3;
-  auto fluid = tank::fluid_parameters(cfg);
-  fluid.same_resolution_pairs = true;
-  const double x_b = cfg.width + gap, x_max = x_b + cfg.width;
-  const double dt = 2 * 0.2 * 0.5 * dp * cfg.smoothing_ratio / cfg.sound_speed();
-  auto fixed = [](double step) {
-    TimeStepParameters<double> s;
-    s.fixed_dt = step;
-    return s;
-  };
-  auto make_scene = [&](bool with_a, bool with_b) {
-    tank::System s = make_system(x_max, cfg);
-    if (with_a) add_tank(s, 0, cfg, dp);
-    if (with_b) add_tank(s, x_b, cfg, 0.5 * dp);
-    if (with_a) set_sloshing(s, 0, cfg.width, cfg.depth, 0.2);
-    if (with_b) set_sloshing(s, x_b, x_max, cfg.depth, 0.2);
-    return s;
-  };
+  const TwoTanks tanks;
+  const auto& [cfg, dp, gap, x_b, x_max, dt, fluid] = tanks;
+  auto fixed = fixed_step;
+  auto make_scene = [&](bool with_a, bool with_b) { return tanks.scene(with_a, with_b); };
   const int macro_steps = 30;
   tank::System only_a = make_scene(true, false), a_half_step = make_scene(true, false),
                only_b = make_scene(false, true);
