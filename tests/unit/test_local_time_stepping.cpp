@@ -143,11 +143,10 @@ TEST_CASE("local time stepping: a coarse and a fine tank in one scene each advan
                a_half_step = tanks.scene(true, false);
   const auto count_a = static_cast<std::uint32_t>(only_a.particles().size());
   const auto count_b = static_cast<std::uint32_t>(only_b.particles().size());
-  auto fixed = fixed_step;
   const int macro_steps = 30;
-  LocalTankSimulation local(both, fluid, fixed(dt));
-  tank::TankSimulation run_a(only_a, fluid, fixed(dt)), run_b(only_b, fluid, fixed(0.5 * dt)),
-      run_a_half(a_half_step, fluid, fixed(0.5 * dt));
+  LocalTankSimulation local(both, fluid, fixed_step(dt));
+  tank::TankSimulation run_a(only_a, fluid, fixed_step(dt)), run_b(only_b, fluid, fixed_step(0.5 * dt)),
+      run_a_half(a_half_step, fluid, fixed_step(0.5 * dt));
   for (int k = 0; k < macro_steps; ++k) {
     local.step();
     run_a.step();
@@ -286,15 +285,13 @@ TEST_CASE("local time stepping: coarse particles in a fine-step region step with
   // error (A with dt against A with dt / 2) of the run with dt / 2, and its mass and particle-steps are counted.
   const TwoTanks tanks;
   const auto& [cfg, dp, gap, x_b, x_max, dt, fluid] = tanks;
-  auto fixed = fixed_step;
-  auto make_scene = [&](bool with_a, bool with_b) { return tanks.scene(with_a, with_b); };
   const int macro_steps = 30;
-  tank::System only_a = make_scene(true, false), a_half_step = make_scene(true, false),
-               only_b = make_scene(false, true);
+  tank::System only_a = tanks.scene(true, false), a_half_step = tanks.scene(true, false),
+               only_b = tanks.scene(false, true);
   const auto count_a = static_cast<std::uint32_t>(only_a.particles().size());
   const auto count_b = static_cast<std::uint32_t>(only_b.particles().size());
-  tank::TankSimulation run_a(only_a, fluid, fixed(dt)), run_a_half(a_half_step, fluid, fixed(0.5 * dt)),
-      run_b(only_b, fluid, fixed(0.5 * dt));
+  tank::TankSimulation run_a(only_a, fluid, fixed_step(dt)), run_a_half(a_half_step, fluid, fixed_step(0.5 * dt)),
+      run_b(only_b, fluid, fixed_step(0.5 * dt));
   for (int k = 0; k < macro_steps; ++k) {
     run_a.step();
     run_a_half.step();
@@ -306,8 +303,8 @@ TEST_CASE("local time stepping: coarse particles in a fine-step region step with
   const double below = -cfg.depth, above = 2 * cfg.wall_height;
 
   SECTION("a region over all of A") {
-    tank::System both = make_scene(true, true);
-    LocalTankSimulation local(both, fluid, fixed(dt));
+    tank::System both = tanks.scene(true, true);
+    LocalTankSimulation local(both, fluid, fixed_step(dt));
     local.set_fine_step_regions({{V2(-cfg.depth, below), V2(cfg.width + 0.5 * gap, above)}});
     for (int k = 0; k < macro_steps; ++k) local.step();
     CHECK(local.coarse_particle_count() == 0);
@@ -322,8 +319,8 @@ TEST_CASE("local time stepping: coarse particles in a fine-step region step with
     CHECK(step_effect >= 100 * tolerance);
   }
   SECTION("a region over A's left half") {
-    tank::System both = make_scene(true, true);
-    LocalTankSimulation local(both, fluid, fixed(dt));
+    tank::System both = tanks.scene(true, true);
+    LocalTankSimulation local(both, fluid, fixed_step(dt));
     local.set_fine_step_regions({{V2(-cfg.depth, below), V2(0.5 * cfg.width, above)}});
     std::size_t fast_a = 0;
     for (std::size_t i = 0; i < count_a; ++i) fast_a += both.particles().position[i][0] <= 0.5 * cfg.width;
@@ -345,11 +342,11 @@ TEST_CASE("local time stepping: coarse particles in a fine-step region step with
     CHECK(error_b <= 1e-10 * dp);  // B never meets A: untouched by the split
   }
   SECTION("bad regions") {
-    tank::System both = make_scene(true, true);
-    LocalTankSimulation local(both, fluid, fixed(dt));
+    tank::System both = tanks.scene(true, true);
+    LocalTankSimulation local(both, fluid, fixed_step(dt));
     REQUIRE_THROWS_WITH(local.set_fine_step_regions({{V2(0.3, 0), V2(0.1, 1)}}),
                         Catch::Contains("set_fine_step_regions") && Catch::Contains("lower < upper"));
-    tank::TankSimulation global(only_a, fluid, fixed(dt));
+    tank::TankSimulation global(only_a, fluid, fixed_step(dt));
     REQUIRE_THROWS_WITH(global.set_fine_step_regions({{V2(0, 0), V2(1, 1)}}), Catch::Contains("local-time-stepping"));
   }
 }
