@@ -1,5 +1,6 @@
 // Tests of the wave flume tools: linear theory and Biesel transfer functions, the wavemaker's motion, zero-crossing
 // analysis, the Dalrymple et al. (1984) decay fit and drag-coefficient inversion, the damping zone and the gauges.
+#include <sphfsi/analysis/harmonic_fit.hpp>
 #include <sphfsi/analysis/line_fit.hpp>
 #include <sphfsi/analysis/vegetation_drag.hpp>
 #include <sphfsi/analysis/wave_reflection.hpp>
@@ -15,6 +16,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -436,6 +438,59 @@ TEST_CASE("fit_line: an exact line, the slope's standard error against Monte Car
   CHECK_THROWS_AS(analysis::fit_line({1.0, 1.0}, {2.0, 3.0}), InputError);
   CHECK_THROWS_AS(analysis::fit_line({1.0, 2.0}, {2.0}), InputError);
   CHECK_THROWS_AS(analysis::fit_line({1.0, 2.0}, {2.0, 3.0}, {0.1}), InputError);
+}
+
+TEST_CASE(
+    "fit_harmonics: a drifting two-harmonic record recovered exactly, noise at the least-squares error, bad input",
+    "[waves][analysis]") {
+  // 4.9 periods of T = 1.2 s sampled at T / 40 (the flume's tip record): A1 = 15 mm, A2 = 2 mm, under a quadratic
+  // drift that moves the mean by 10 mm over the window
+  const double T = 1.2, omega = 2 * pi / T, t0 = 4.74, t1 = t0 + 4.9 * T;
+  std::vector<double> t, y;
+  for (double ti = t0; ti <= t1 + 1e-12; ti += T / 40) {
+    const double tau = (ti - 0.5 * (t0 + t1)) / (0.5 * (t1 - t0));
+    t.push_back(ti);
+    y.push_back(-0.003 + 0.005 * tau + 0.002 * tau * tau + 0.015 * std::cos(omega * ti - 0.7) +
+                0.002 * std::cos(2 * omega * ti + 0.3));
+  }
+  const auto fit = analysis::fit_harmonics(t, y, omega, t0, t1, 2, 2);
+  CHECK_THAT(fit.amplitude.at(0), WithinAbs(0.015, 1e-12));
+  CHECK_THAT(fit.amplitude.at(1), WithinAbs(0.002, 1e-12));
+  CHECK_THAT(fit.phase.at(0), WithinAbs(0.7, 1e-10));
+  CHECK_THAT(fit.phase.at(1), WithinAbs(-0.3, 1e-10));
+  CHECK_THAT(fit.drift.at(1), WithinAbs(0.005, 1e-12));
+  // mean of c0 + c1 tau + c2 tau^2 over [-1, 1]: c0 + c2 / 3 (trapezoid on 200 intervals: error c2 / 3 / 200^2)
+  CHECK_THAT(fit.mean, WithinAbs(-0.003 + 0.002 / 3, 1e-7));
+  CHECK_THAT(fit.drift_range, WithinAbs(0.010, 1e-9));  // from tau = -1 (-0.006) to tau = 1 (+0.004)
+  CHECK(fit.residual_rms < 1e-13);
+  // the half peak-to-peak of the same record counts the drift: well above A1
+  const auto [lo, hi] = std::minmax_element(y.begin(), y.end());
+  CHECK(0.5 * (*hi - *lo) > 0.018);
+  // a drift left out of the model (degree 0) biases A1 and leaves a residual
+  CHECK(analysis::fit_harmonics(t, y, omega, t0, t1, 2, 0).residual_rms > 1e-3);
+  // white noise s: the amplitude's standard error is about s sqrt(2 / n) (n samples, the harmonics nearly orthogonal to
+  // the drift); the scatter of 2,000 fits has a relative standard error of 1 / sqrt(4,000) = 1.6 %: 5 % allows three
+  std::mt19937 rng(5);
+  std::normal_distribution<double> noise(0, 0.002);
+  double sum = 0, sum2 = 0;
+  const int fits = 2000;
+  for (int k = 0; k < fits; ++k) {
+    std::vector<double> yk = y;
+    for (double& v : yk) v += noise(rng);
+    const double a = analysis::fit_harmonics(t, yk, omega, t0, t1, 2, 2).amplitude[0];
+    sum += a, sum2 += a * a;
+  }
+  const double sd = std::sqrt(sum2 / fits - (sum / fits) * (sum / fits));
+  CHECK_THAT(sum / fits, WithinAbs(0.015, 4 * sd / std::sqrt(double(fits)) + 1e-5));
+  CHECK_THAT(sd, WithinRel(0.002 * std::sqrt(2.0 / double(t.size())), 0.05));
+  CHECK_THROWS_AS(analysis::fit_harmonics(t, y, 0.0, t0, t1), InputError);
+  CHECK_THROWS_AS(analysis::fit_harmonics(t, y, omega, t0, t0 + 0.5 * T), InputError);
+  CHECK_THROWS_AS(analysis::fit_harmonics(t, y, omega, t0, t1, 0), InputError);
+  CHECK_THROWS_AS(analysis::fit_harmonics(t, y, omega, t0, t1, 1, 5), InputError);
+  CHECK_THROWS_AS(analysis::fit_harmonics(std::vector<double>{1.0}, y, omega, t0, t1), InputError);
+  std::vector<double> bad = y;
+  bad[10] = std::nan("");
+  CHECK_THROWS_AS(analysis::fit_harmonics(t, bad, omega, t0, t1), InputError);
 }
 
 TEST_CASE("oscillatory plate drag: C_D = max(10 KC^(-1/3), 1.95) of Luhar & Nepf 2016", "[waves][analysis]") {
