@@ -15,6 +15,7 @@
 // --refine on (drag blades, --runs plants): fine fluid (dp / 2) around the plants only, by adaptive particle
 // refinement (scenes::PlantRefinement); --reference DIR compares it with a uniformly fine run in DIR
 // (docs/variable-resolution.md section 4); --local-steps on steps the coarse fluid at twice the fine step.
+#include <sphfsi/analysis/harmonic_fit.hpp>
 #include <sphfsi/analysis/wave_reflection.hpp>
 #include <sphfsi/analysis/zero_crossing.hpp>
 #include <sphfsi/coupling/coupled_body.hpp>
@@ -46,6 +47,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <limits>
+#include <numbers>
 #include <optional>
 #include <string>
 #include <vector>
@@ -84,6 +86,9 @@ struct CaseResult {
   std::vector<double> tip_dx_amplitude, tip_dz_amplitude, tip_dx_mean, tip_dz_mean;  // per plant, m
   std::vector<double> water_dx_amplitude, water_dx_mean;  // the water beside each tip, per plant, m
   std::vector<double> tip_dz_lowest;                      // per plant, over the whole run, m
+  // the periodic part of the tip's motion (4 harmonics of the wave under a quadratic drift, analysis::fit_harmonics):
+  // its half peak-to-peak in x and z, and the range of the fitted drift of x over the window, per plant, m
+  std::vector<double> tip_dx_periodic, tip_dz_periodic, tip_dx_drift_range;
   std::vector<double> current_mean;  // the Eulerian mean horizontal velocity at each plant's mid-height, m/s
   // incident and reflected amplitudes at the paddle's frequency from the gauges upstream of the plants, m (NaN: fewer
   // than two such gauges, or no complete record)
@@ -279,6 +284,19 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
     tips_csv.emplace(dir / "tips.csv", tip_columns,
                      fmt::format("plant tip (top row mean) displacement (m); plant centre lines x = {} m",
                                  fmt::join(layout.plant_x, ", ")));
+  // the active fluid's volume sum m / rho and mass, per unit width: water that a refinement box adds or removes at
+  // fixed mass (the mass account rescales masses at fixed density) raises or lowers the mean level along the flume
+  io::CsvWriter volume_csv(dir / "fluid_volume.csv", {"t", "active_volume", "active_mass"},
+                           "active fluid particles: sum of m / rho (m^2 per m width) and of m (kg per m width)");
+  auto record_volume = [&](const System& s, double t) {
+    const auto& p = s.particles();
+    double volume = 0, mass = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      if (p.kind[i] != Kind::fluid || p.passive[i]) continue;
+      volume += double(p.mass[i] / p.density[i]), mass += double(p.mass[i]);
+    }
+    volume_csv.write_row({t, volume, mass});
+  };
   auto tip_position = [&](const System& s, std::size_t k) {
     if constexpr (Rods) return Vec<2, T>(sim.template model<1>().rod(k).tip_position());
     Vec<2, T> c = Vec<2, T>::Zero();
@@ -308,6 +326,7 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
       }
       if (double(sm.time()) + 1e-9 >= next_sample) {
         gauges.sample(sm.system(), sm.time());
+        record_volume(sm.system(), double(sm.time()));
         if constexpr (WithPlants) {
           std::vector<double> row{double(sm.time())};
           times.push_back(double(sm.time()));
@@ -470,16 +489,34 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
     r.water_dx_mean.push_back(n ? sum_w / double(n) : nan);
     r.current_mean.push_back(n ? sum_u / double(n) : nan);
     r.tip_dz_lowest.push_back(tip_dz[k].empty() ? nan : *std::min_element(tip_dz[k].begin(), tip_dz[k].end()));
+    double periodic_x = nan, periodic_z = nan, drift_x = nan;
+    if (!times.empty()) {
+      try {
+        const double omega = 2 * std::numbers::pi / double(wave.period);
+        const auto fx = analysis::fit_harmonics(times, tip_dx[k], omega, from, times.back(), 4, 2);
+        const auto fz = analysis::fit_harmonics(times, tip_dz[k], omega, from, times.back(), 4, 2);
+        periodic_x = fx.periodic_half_range(), periodic_z = fz.periodic_half_range(), drift_x = fx.drift_range;
+      } catch (const InputError&) {
+        // a record shorter than one period after the full waves arrive: no periodic part (NaN)
+      }
+    }
+    r.tip_dx_periodic.push_back(periodic_x);
+    r.tip_dz_periodic.push_back(periodic_z);
+    r.tip_dx_drift_range.push_back(drift_x);
   }
   if constexpr (WithPlants) {
-    io::CsvWriter motion(dir / "plant_motion.csv",
-                         {"x", "tip_dx_amplitude", "tip_dz_amplitude", "tip_dx_mean", "tip_dz_mean",
-                          "water_dx_amplitude", "current_mean"},
-                         "per plant, once the full waves have arrived: tip excursion (half peak-to-peak) and mean "
-                         "displacement (m), the water beside the tip (m), the mean current at mid-height (m/s)");
+    io::CsvWriter motion(
+        dir / "plant_motion.csv",
+        {"x", "tip_dx_amplitude", "tip_dz_amplitude", "tip_dx_mean", "tip_dz_mean", "water_dx_amplitude",
+         "current_mean", "tip_dx_periodic", "tip_dz_periodic", "tip_dx_drift_range"},
+        "per plant, once the full waves have arrived: tip excursion (half peak-to-peak) and mean "
+        "displacement (m), the water beside the tip (m), the mean current at mid-height (m/s); the "
+        "half peak-to-peak of the tip's periodic part (4 wave harmonics fitted under a quadratic "
+        "drift) and the drift's range in x (m)");
     for (std::size_t k = 0; k < plant_count; ++k)
       motion.write_row({double(layout.plant_x[k]), r.tip_dx_amplitude[k], r.tip_dz_amplitude[k], r.tip_dx_mean[k],
-                        r.tip_dz_mean[k], r.water_dx_amplitude[k], r.current_mean[k]});
+                        r.tip_dz_mean[k], r.water_dx_amplitude[k], r.current_mean[k], r.tip_dx_periodic[k],
+                        r.tip_dz_periodic[k], r.tip_dx_drift_range[k]});
   }
   return r;
 }
@@ -516,10 +553,12 @@ bool compare_with_reference(const Options& o, const CaseResult& with) {
     if (run_column[i] == 1) reference_steps = steps_column[i];
   io::CsvWriter out(
       o.out / "refinement_comparison.csv", {"quantity", "index", "refined", "reference", "error"},
-      fmt::format("refined run against the uniformly fine run in {}; errors relative (H: to the "
-                  "reference H; tip dx, dz: to the reference tip dx excursion); quantity 0 H, 1 tip dx, 2 tip dz, 3 "
-                  "particle-steps (error: the saving), 4 incident amplitude, 5 K_r (error: the difference)",
-                  o.reference.string()));
+      fmt::format(
+          "refined run against the uniformly fine run in {}; errors relative (H: to the "
+          "reference H; tip dx, dz: to the reference tip dx excursion); quantity 0 H, 1 tip dx, 2 tip dz, 3 "
+          "particle-steps (error: the saving), 4 incident amplitude, 5 K_r (error: the difference), 6 periodic tip dx, "
+          "7 periodic tip dz (to the reference periodic dx)",
+          o.reference.string()));
   bool pass = true;
   fmt::print("\nagainst the uniformly fine run ({}):\n", o.reference.string());
   for (std::size_t i = 0; i < H.size(); ++i) {
@@ -539,6 +578,22 @@ bool compare_with_reference(const Options& o, const CaseResult& with) {
         100 * ez);
     out.write_row({1, double(k), with.tip_dx_amplitude[k], dx[k], ex});
     out.write_row({2, double(k), with.tip_dz_amplitude[k], dz[k], ez});
+  }
+  // diagnostic, no criterion: the tip's periodic part, apart from the drift of its mean position (references written
+  // before session 28 lack these columns)
+  if (motion.has_column("tip_dx_periodic")) {
+    const auto px = motion.column("tip_dx_periodic"), pz = motion.column("tip_dz_periodic"),
+               mean = motion.column("tip_dx_mean");
+    for (std::size_t k = 0; k < px.size(); ++k) {
+      const double ex = with.tip_dx_periodic[k] / px[k] - 1, ez = (with.tip_dz_periodic[k] - pz[k]) / px[k];
+      fmt::print(
+          "  plant {} periodic part: dx {:.2f} mm, fine {:.2f} mm: {:+.2f} %; dz {:.2f} mm, fine {:.2f} mm: {:+.2f} % "
+          "of dx; mean dx {:+.2f} mm, fine {:+.2f} mm (no criterion)\n",
+          k, 1e3 * with.tip_dx_periodic[k], 1e3 * px[k], 100 * ex, 1e3 * with.tip_dz_periodic[k], 1e3 * pz[k], 100 * ez,
+          1e3 * with.tip_dx_mean[k], 1e3 * mean[k]);
+      out.write_row({6, double(k), with.tip_dx_periodic[k], px[k], ex});
+      out.write_row({7, double(k), with.tip_dz_periodic[k], pz[k], ez});
+    }
   }
   // diagnostic, no criterion: the incident wave and its reflection upstream of the plants (reflection.csv)
   if (std::filesystem::exists(dir / "reflection.csv") && !std::isnan(with.incident_amplitude)) {
@@ -654,6 +709,12 @@ int run(const Options& o) {
       fmt::print("  plant {} at x = {:.3f} m: |dx| {:.2f} mm, |dz| {:.2f} mm; mean dx {:+.2f} mm, dz {:+.2f} mm\n", k,
                  double(scene.plant_x()[k]), 1e3 * with.tip_dx_amplitude[k], 1e3 * with.tip_dz_amplitude[k],
                  1e3 * with.tip_dx_mean[k], 1e3 * with.tip_dz_mean[k]);
+    fmt::print(
+        "periodic part of the tip's motion (4 wave harmonics under a quadratic drift; half peak-to-peak) and the "
+        "drift's range:\n");
+    for (std::size_t k = 0; k < with.tip_dx_periodic.size(); ++k)
+      fmt::print("  plant {}: periodic |dx| {:.2f} mm, |dz| {:.2f} mm; the mean position drifts over {:.2f} mm in x\n",
+                 k, 1e3 * with.tip_dx_periodic[k], 1e3 * with.tip_dz_periodic[k], 1e3 * with.tip_dx_drift_range[k]);
     fmt::print(
         "the water beside each tip (fluid particles that started within 1.5 dp of it) and the Eulerian mean current "
         "at the plant's mid-height:\n");

@@ -463,6 +463,21 @@ TEST_CASE(
   CHECK_THAT(fit.mean, WithinAbs(-0.003 + 0.002 / 3, 1e-7));
   CHECK_THAT(fit.drift_range, WithinAbs(0.010, 1e-9));  // from tau = -1 (-0.006) to tau = 1 (+0.004)
   CHECK(fit.residual_rms < 1e-13);
+  // the periodic part's half range: A1 alone for one harmonic; with the second, the extremes of 15 cos(theta - 0.7)
+  // + 2 cos(2 theta + 0.3) mm, found here by bisection on the derivative (independent of the fit's phase grid)
+  auto part = [](double th) { return 0.015 * std::cos(th - 0.7) + 0.002 * std::cos(2 * th + 0.3); };
+  auto slope = [](double th) { return -0.015 * std::sin(th - 0.7) - 0.004 * std::sin(2 * th + 0.3); };
+  auto root = [&](double a, double b) {
+    for (int i = 0; i < 100; ++i) {
+      const double c = 0.5 * (a + b);
+      (slope(a) * slope(c) <= 0 ? b : a) = c;
+    }
+    return 0.5 * (a + b);
+  };
+  const double top = part(root(0.7 - 1, 0.7 + 1)), bottom = part(root(0.7 + pi - 1, 0.7 + pi + 1));
+  CHECK_THAT(fit.periodic_half_range(), WithinAbs(0.5 * (top - bottom), 1e-7));
+  CHECK_THAT(analysis::fit_harmonics(t, y, omega, t0, t1, 1, 2).periodic_half_range(),
+             WithinRel(analysis::fit_harmonics(t, y, omega, t0, t1, 1, 2).amplitude[0], 1e-5));
   // the half peak-to-peak of the same record counts the drift: well above A1
   const auto [lo, hi] = std::minmax_element(y.begin(), y.end());
   CHECK(0.5 * (*hi - *lo) > 0.018);

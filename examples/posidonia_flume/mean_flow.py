@@ -1,0 +1,104 @@
+"""The slow part of a posidonia_flume run: the plant's mean position, the mean current beside it, and the long waves.
+
+Usage: /usr/bin/python3 examples/posidonia_flume/mean_flow.py REFERENCE_DIR RUN_DIR... [--csv FILE]
+
+For each run folder (written with --runs plants or both), from DIR/plants/gauges.csv and DIR/plants/tips.csv:
+  * H at each gauge against the reference run's (DIR/plants/wave_heights.csv), %;
+  * the tip's half peak-to-peak excursion in x (the example's criterion) and the half peak-to-peak of its periodic
+    part: 4 harmonics of the wave fitted together with a quadratic drift (as analysis::fit_harmonics), mm;
+  * the tip's mean displacement and the Eulerian mean current at the plant's mid-height, mm and mm/s;
+  * the long waves: the mean level of each gauge over one wave period, every half period from 4.2 s on. "spread" is
+    the mean over those windows of the largest difference between the gauges (a level gradient along the flume);
+    "wander" the rms of each gauge's window means about their straight-line trend, averaged over the gauges, mm.
+All over the window the example uses for the tip (from the ramp, the wave's travel to the plant and one period).
+"""
+import sys
+
+import numpy as np
+
+T = 1.2                       # wave period, s (the example's default)
+GROUP_VELOCITY = 1.053        # c_g at h = 0.2 m, T = 1.2 s, m/s (the example prints it)
+PLANT_X = 1.2                 # m
+TIP_FROM = 2 * T + PLANT_X / GROUP_VELOCITY + T
+LEVEL_FROM = 4.2
+
+
+def read(path):
+    """A CSV of the example: a '# ...' comment line (not in every file), then the column names."""
+    with open(path) as f:
+        comment = f.readline().startswith('#')
+    return np.genfromtxt(path, delimiter=',', names=True, skip_header=1 if comment else 0)
+
+
+def periodic_half_range(t, y, harmonics=4, degree=2):
+    omega = 2 * np.pi / T
+    tau = (t - 0.5 * (t[0] + t[-1])) / (0.5 * (t[-1] - t[0]))
+    columns = [tau ** p for p in range(degree + 1)]
+    for n in range(1, harmonics + 1):
+        columns += [np.cos(n * omega * t), np.sin(n * omega * t)]
+    c = np.linalg.lstsq(np.column_stack(columns), y, rcond=None)[0]
+    phase = np.linspace(0, 2 * np.pi, 2000, endpoint=False)
+    part = sum(c[degree + 2 * n - 1] * np.cos(n * phase) + c[degree + 2 * n] * np.sin(n * phase)
+               for n in range(1, harmonics + 1))
+    return 0.5 * (part.max() - part.min())
+
+
+def heights(run):
+    return read(run + '/plants/wave_heights.csv')['H']
+
+
+def analyse(run, reference_heights):
+    tips = read(run + '/plants/tips.csv')
+    window = tips['t'] >= TIP_FROM - 1e-9
+    t, dx, u = tips['t'][window], tips['dx_0'][window], tips['u_mid_0'][window]
+    gauges = read(run + '/plants/gauges.csv')
+    names = [n for n in gauges.dtype.names if n.startswith('eta')]
+    means, start = [], LEVEL_FROM
+    while start + T <= gauges['t'][-1] + 1e-6:
+        w = (gauges['t'] >= start) & (gauges['t'] < start + T)
+        means.append([np.nanmean(gauges[n][w]) for n in names])
+        start += T / 2
+    means = 1e3 * np.array(means)
+    k = np.arange(len(means))
+    wander = np.mean([np.std(means[:, j] - np.polyval(np.polyfit(k, means[:, j], 1), k))
+                      for j in range(means.shape[1])])
+    h = heights(run)
+    return dict(H=100 * (h / reference_heights - 1), half_peak_to_peak=1e3 * 0.5 * (dx.max() - dx.min()),
+                periodic=1e3 * periodic_half_range(t, dx), lean=1e3 * dx.mean(), current=1e3 * u.mean(),
+                spread=np.mean(means.max(1) - means.min(1)), wander=wander)
+
+
+def main(argv):
+    csv_path = None
+    if '--csv' in argv:
+        i = argv.index('--csv')
+        csv_path = argv[i + 1]
+        argv = argv[:i] + argv[i + 2:]
+    if len(argv) < 2:
+        sys.exit(__doc__)
+    reference = argv[0]
+    h_ref = heights(reference)
+    rows = []
+    print(f"{'run':30s} {'H vs reference, % (per gauge)':>36s} | {'hpp dx':>6s} {'periodic':>8s} {'lean':>6s} "
+          f"{'current':>7s} | {'spread':>6s} {'wander':>6s}")
+    for run in argv:
+        r = analyse(run, h_ref)
+        rows.append((run, r))
+        print(f"{run:30s} " + ' '.join(f'{e:+8.2f}' for e in r['H']) +
+              f" | {r['half_peak_to_peak']:6.2f} {r['periodic']:8.2f} {r['lean']:+6.2f} {r['current']:+7.2f} | "
+              f"{r['spread']:6.2f} {r['wander']:6.2f}")
+    if csv_path:
+        with open(csv_path, 'w') as f:
+            f.write('# examples/posidonia_flume/mean_flow.py against ' + reference + ': H error per gauge (%), tip half '
+                    'peak-to-peak and periodic half range (mm), mean lean (mm), mean current at mid-height (mm/s), '
+                    'long-wave spread and wander (mm)\n')
+            f.write('run,' + ','.join(f'H_error_{i}' for i in range(len(h_ref))) +
+                    ',tip_half_peak_to_peak,tip_periodic,lean,current,level_spread,level_wander\n')
+            for run, r in rows:
+                f.write(run + ',' + ','.join(f'{e:.3f}' for e in r['H']) +
+                        f",{r['half_peak_to_peak']:.3f},{r['periodic']:.3f},{r['lean']:.3f},{r['current']:.3f},"
+                        f"{r['spread']:.3f},{r['wander']:.3f}\n")
+
+
+if __name__ == '__main__':
+    main(sys.argv[1:])
