@@ -1,6 +1,6 @@
 """The slow part of a posidonia_flume run: the plant's mean position, the mean current beside it, and the long waves.
 
-Usage: /usr/bin/python3 examples/posidonia_flume/mean_flow.py REFERENCE_DIR RUN_DIR... [--csv FILE]
+Usage: /usr/bin/python3 examples/posidonia_flume/mean_flow.py REFERENCE_DIR RUN_DIR... [--csv FILE] [--plot PNG]
 
 For each run folder (written with --runs plants or both), from DIR/plants/gauges.csv and DIR/plants/tips.csv:
   * H at each gauge against the reference run's (DIR/plants/wave_heights.csv), %;
@@ -11,6 +11,8 @@ For each run folder (written with --runs plants or both), from DIR/plants/gauges
     the mean over those windows of the largest difference between the gauges (a level gradient along the flume);
     "wander" the rms of each gauge's window means about their straight-line trend, averaged over the gauges, mm.
 All over the window the example uses for the tip (from the ramp, the wave's travel to the plant and one period).
+--plot draws the tip's excursion and its periodic part against the reference's, over the level's wander and over the
+mean lean; runs whose folder name contains 'pf40' are drawn as uniformly fine, 'pf20' as uniformly coarse.
 """
 import sys
 
@@ -68,12 +70,48 @@ def analyse(run, reference_heights):
                 spread=np.mean(means.max(1) - means.min(1)), wander=wander)
 
 
+def option(argv, name):
+    if name not in argv:
+        return None, argv
+    i = argv.index(name)
+    return argv[i + 1], argv[:i] + argv[i + 2:]
+
+
+def plot(path, rows):
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+    reference = rows[0][1]
+    groups = {'uniformly fine (h/dp = 40)': ('pf40', 'k', 'o'), 'uniformly coarse (h/dp = 20)': ('pf20', 'tab:blue', 's'),
+              'refined box (h/dp = 20 / 40)': ('', 'tab:red', '^')}
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+    for label, (key, colour, marker) in groups.items():
+        chosen = [r for name, r in rows if key in name and not any(k in name for k in ('pf40', 'pf20') if k != key)]
+        if not chosen:
+            continue
+        wander = [r['wander'] for r in chosen]
+        hpp = [100 * (r['half_peak_to_peak'] / reference['half_peak_to_peak'] - 1) for r in chosen]
+        periodic = [100 * (r['periodic'] / reference['periodic'] - 1) for r in chosen]
+        axes[0].scatter(wander, hpp, c=colour, marker=marker, label=label)
+        axes[1].scatter([r['lean'] for r in chosen], periodic, c=colour, marker=marker, label=label)
+    for ax in axes:
+        ax.axhspan(-5, 5, color='0.9', zorder=0)
+        ax.grid(alpha=0.3)
+    axes[0].set_xlabel('wander of the mean level at the gauges (mm)')
+    axes[0].set_ylabel('tip excursion (half peak-to-peak) vs the fine run (%)')
+    axes[0].set_title('the tip criterion against the long waves')
+    axes[1].set_xlabel('mean lean of the tip (mm; < 0 upstream)')
+    axes[1].set_ylabel('periodic part of the tip motion vs the fine run (%)')
+    axes[1].set_title('the wave-driven sway against the mean position')
+    axes[1].legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    print('plot:', path)
+
+
 def main(argv):
-    csv_path = None
-    if '--csv' in argv:
-        i = argv.index('--csv')
-        csv_path = argv[i + 1]
-        argv = argv[:i] + argv[i + 2:]
+    csv_path, argv = option(argv, '--csv')
+    plot_path, argv = option(argv, '--plot')
     if len(argv) < 2:
         sys.exit(__doc__)
     reference = argv[0]
@@ -98,6 +136,8 @@ def main(argv):
                 f.write(run + ',' + ','.join(f'{e:.3f}' for e in r['H']) +
                         f",{r['half_peak_to_peak']:.3f},{r['periodic']:.3f},{r['lean']:.3f},{r['current']:.3f},"
                         f"{r['spread']:.3f},{r['wander']:.3f}\n")
+    if plot_path:
+        plot(plot_path, rows)
 
 
 if __name__ == '__main__':
