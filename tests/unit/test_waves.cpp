@@ -20,6 +20,7 @@
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <utility>
 #include <vector>
 
 using namespace sphfsi;
@@ -42,6 +43,22 @@ double biesel_by_quadrature(double kh, F profile) {
   }
   const double integral = sum / (3.0 * n) * kh;  // k Int_0^h f cosh(ks) ds = kh Int_0^1 f(u) cosh(kh u) du
   return 4 * std::sinh(kh) * integral / (std::sinh(2 * kh) + 2 * kh);
+}
+
+// Mean and standard deviation of statistic(y + noise) over n draws of white noise of standard deviation s.
+template <class Statistic>
+std::pair<double, double> noisy_scatter(const std::vector<double>& y, double s, int n, unsigned seed,
+                                        Statistic statistic) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0, s);
+  double sum = 0, sum2 = 0;
+  for (int k = 0; k < n; ++k) {
+    std::vector<double> yk = y;
+    for (double& v : yk) v += noise(rng);
+    const double q = statistic(yk);
+    sum += q, sum2 += q * q;
+  }
+  return {sum / n, std::sqrt(sum2 / n - (sum / n) * (sum / n))};
 }
 }  // namespace
 
@@ -422,17 +439,9 @@ TEST_CASE("fit_line: an exact line, the slope's standard error against Monte Car
   CHECK_THAT(analysis::fit_line(x, y, s).slope_error, WithinRel(0.01 / std::sqrt(10.0), 1e-12));
   // the same against the scatter of 20,000 noisy fits (relative standard error of a standard deviation from
   // n samples: 1 / sqrt(2 n) = 0.5 %; 3 % allows six of them)
-  std::mt19937 rng(17);
-  std::normal_distribution<double> noise(0, 0.01);
-  double sum = 0, sum2 = 0;
-  const int n = 20000;
-  for (int k = 0; k < n; ++k) {
-    std::vector<double> yk = y;
-    for (double& v : yk) v += noise(rng);
-    const double b = analysis::fit_line(x, yk).slope;
-    sum += b, sum2 += b * b;
-  }
-  const double sd = std::sqrt(sum2 / n - (sum / n) * (sum / n));
+  const auto [mean_slope, sd] =
+      noisy_scatter(y, 0.01, 20000, 17, [&](const std::vector<double>& yk) { return analysis::fit_line(x, yk).slope; });
+  CHECK_THAT(mean_slope, WithinAbs(-0.02, 4 * sd / std::sqrt(20000.0)));
   CHECK_THAT(sd, WithinRel(0.01 / std::sqrt(10.0), 0.03));
   CHECK_THROWS_AS(analysis::fit_line({1.0}, {2.0}), InputError);
   CHECK_THROWS_AS(analysis::fit_line({1.0, 1.0}, {2.0, 3.0}), InputError);
@@ -485,18 +494,11 @@ TEST_CASE(
   CHECK(analysis::fit_harmonics(t, y, omega, t0, t1, 2, 0).residual_rms > 1e-3);
   // white noise s: the amplitude's standard error is about s sqrt(2 / n) (n samples, the harmonics nearly orthogonal to
   // the drift); the scatter of 2,000 fits has a relative standard error of 1 / sqrt(4,000) = 1.6 %: 5 % allows three
-  std::mt19937 rng(5);
-  std::normal_distribution<double> noise(0, 0.002);
-  double sum = 0, sum2 = 0;
   const int fits = 2000;
-  for (int k = 0; k < fits; ++k) {
-    std::vector<double> yk = y;
-    for (double& v : yk) v += noise(rng);
-    const double a = analysis::fit_harmonics(t, yk, omega, t0, t1, 2, 2).amplitude[0];
-    sum += a, sum2 += a * a;
-  }
-  const double sd = std::sqrt(sum2 / fits - (sum / fits) * (sum / fits));
-  CHECK_THAT(sum / fits, WithinAbs(0.015, 4 * sd / std::sqrt(double(fits)) + 1e-5));
+  const auto [mean_amplitude, sd] = noisy_scatter(y, 0.002, fits, 5, [&](const std::vector<double>& yk) {
+    return analysis::fit_harmonics(t, yk, omega, t0, t1, 2, 2).amplitude[0];
+  });
+  CHECK_THAT(mean_amplitude, WithinAbs(0.015, 4 * sd / std::sqrt(double(fits)) + 1e-5));
   CHECK_THAT(sd, WithinRel(0.002 * std::sqrt(2.0 / double(t.size())), 0.05));
   CHECK_THROWS_AS(analysis::fit_harmonics(t, y, 0.0, t0, t1), InputError);
   CHECK_THROWS_AS(analysis::fit_harmonics(t, y, omega, t0, t0 + 0.5 * T), InputError);
