@@ -284,8 +284,8 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
     tips_csv.emplace(dir / "tips.csv", tip_columns,
                      fmt::format("plant tip (top row mean) displacement (m); plant centre lines x = {} m",
                                  fmt::join(layout.plant_x, ", ")));
-  // the active fluid's volume sum m / rho and mass, per unit width: water that a refinement box adds or removes at
-  // fixed mass (the mass account rescales masses at fixed density) raises or lowers the mean level along the flume
+  // the active fluid's volume sum m / rho and mass, per unit width: a refinement box's status changes move water
+  // between the active and the passive fluid, and its mass account hands the difference back at fixed density
   io::CsvWriter volume_csv(dir / "fluid_volume.csv", {"t", "active_volume", "active_mass"},
                            "active fluid particles: sum of m / rho (m^2 per m width) and of m (kg per m width)");
   auto record_volume = [&](const System& s, double t) {
