@@ -41,6 +41,7 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -279,6 +280,11 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
   // the Eulerian current at each plant: the fluid's horizontal velocity, Shepard-interpolated at half the blade length
   // above the base (the drag acts on it, where the tracers above follow the water's Lagrangian drift)
   for (std::size_t k = 0; k < plant_count; ++k) tip_columns.push_back(fmt::format("u_mid_{}", k));
+  // the same at l/8, 3l/8, 5l/8 and 7l/8 above the base: the profile of the current the blade stands in
+  const std::array<double, 4> profile_heights{0.125, 0.375, 0.625, 0.875};
+  for (std::size_t k = 0; k < plant_count; ++k)
+    for (double f : profile_heights)
+      tip_columns.push_back(fmt::format("u_{}_z{:.4f}", k, f * double(scene.blade_length())));
   std::optional<io::CsvWriter> tips_csv;
   if (WithPlants)
     tips_csv.emplace(dir / "tips.csv", tip_columns,
@@ -349,6 +355,9 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
             row.push_back(u);
             u_mid[k].push_back(u);
           }
+          for (std::size_t k = 0; k < plant_count; ++k)
+            for (double f : profile_heights)
+              row.push_back(eulerian_velocity(sm.system(), Vec<2, T>(layout.plant_x[k], T(f) * scene.blade_length())));
           tips_csv->write_row(row);
           if constexpr (Rods) {
             const auto& rods = sm.template model<1>();
