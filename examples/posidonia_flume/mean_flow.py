@@ -82,11 +82,14 @@ def plot(path, rows):
     matplotlib.use('Agg')
     import matplotlib.pyplot as plt
     reference = rows[0][1]
-    groups = {'uniformly fine (h/dp = 40)': ('pf40', 'k', 'o'), 'uniformly coarse (h/dp = 20)': ('pf20', 'tab:blue', 's'),
-              'refined box (h/dp = 20 / 40)': ('', 'tab:red', '^')}
+    def group(name):
+        return 'fine' if 'pf40' in name else 'coarse' if 'pf20' in name else 'refined'
+
+    groups = {'uniformly fine (h/dp = 40)': ('fine', 'k', 'o'), 'uniformly coarse (h/dp = 20)': ('coarse', 'tab:blue', 's'),
+              'refined box (h/dp = 20 / 40)': ('refined', 'tab:red', '^')}
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
     for label, (key, colour, marker) in groups.items():
-        chosen = [r for name, r in rows if key in name and not any(k in name for k in ('pf40', 'pf20') if k != key)]
+        chosen = [r for name, r in rows if group(name) == key]
         if not chosen:
             continue
         wander = [r['wander'] for r in chosen]
