@@ -154,7 +154,8 @@ scenes::PosidoniaFlume<T> converted(const scenes::PosidoniaFlume<double>& s) {
                   s.refinement.momentum_account,
                   s.refinement.mass_account,
                   s.refinement.lagrangian,
-                  s.refinement.follow_flow};
+                  s.refinement.follow_flow,
+                  T(s.refinement.distant_fit_interval)};
   return c;
 }
 
@@ -881,6 +882,10 @@ int main(int argc, char** argv) try {
       "follow-flow", false,
       "refinement: the box moves along x with the mean velocity of the fine water in it (at most transition - h/dp "
       "base spacings): on | off");
+  s.refinement.distant_fit_interval = cli.get_number(
+      "distant-fit", 0,
+      "refinement: the passive particles farther than two kernel supports from where their resolution is active are "
+      "fitted at this interval only, s (0: at every pass), [0, 1]");
   o.local_steps = cli.get_switch("local-steps", false,
                                  "refinement: local time stepping, the coarse fluid at twice the fine step: on | off");
   o.fine_step_margin = cli.get_number(

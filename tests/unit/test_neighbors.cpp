@@ -387,6 +387,50 @@ TEMPLATE_TEST_CASE("multi-level search finds exactly the brute-force neighbours 
     CHECK(beyond_end == 0);
     CHECK(once == expected_pairs);
 
+    // Restricted to one size band (pair loops of one resolution, a particle's children): every brute-force
+    // neighbour whose h lies within the band is visited (once per pair with the _once form, which asks for the
+    // visiting particle's own size), and nothing visited is not a neighbour.
+    for (const double tolerance : {1e-3, 0.25}) {
+      CAPTURE(tolerance);
+      std::set<std::pair<std::uint32_t, std::uint32_t>> same_size_once;
+      std::size_t missed = 0, false_neighbours = 0, repeated_same = 0, missed_half = 0;
+      for (std::size_t a = 0; a < n; ++a) {
+        const T ha = p.smoothing_length[a];
+        const auto in_band = [&](T h, T centre) { return std::abs(h - centre) <= T(tolerance) * centre; };
+        std::set<std::uint32_t> own, half;
+        system.for_each_neighbor_of_size(a, ha, T(tolerance), [&](std::size_t b, const auto&, T, T) {
+          false_neighbours += !expected[p.id[a]].count(p.id[b]);
+          own.insert(p.id[b]);
+        });
+        system.for_each_neighbor_of_size(a, T(0.5) * ha, T(tolerance), [&](std::size_t b, const auto&, T, T) {
+          false_neighbours += !expected[p.id[a]].count(p.id[b]);
+          half.insert(p.id[b]);
+        });
+        system.for_each_neighbor_once_of_size(a, ha, T(tolerance), [&](std::size_t b, const auto&, T, T) {
+          if (!in_band(p.smoothing_length[b], ha)) return;
+          repeated_same += !same_size_once.emplace(std::min(p.id[a], p.id[b]), std::max(p.id[a], p.id[b])).second;
+        });
+        for (std::uint32_t ib : expected[p.id[a]]) {
+          const T hb = p.smoothing_length[p.slot_of_id(ib)];
+          missed += in_band(hb, ha) && !own.count(ib);
+          missed_half += in_band(hb, T(0.5) * ha) && !half.count(ib);
+        }
+      }
+      std::set<std::pair<std::uint32_t, std::uint32_t>> expected_same;
+      for (const auto& [ia, ib] : expected_pairs) {
+        const T ha = p.smoothing_length[p.slot_of_id(ia)], hb = p.smoothing_length[p.slot_of_id(ib)];
+        // the _once form is asked for the smaller slot's size: the pair is in band from whichever side visits it
+        const bool a_first = p.slot_of_id(ia) < p.slot_of_id(ib);
+        const T visitor = a_first ? ha : hb, partner = a_first ? hb : ha;
+        if (std::abs(partner - visitor) <= T(tolerance) * visitor) expected_same.emplace(ia, ib);
+      }
+      CHECK(missed == 0);
+      CHECK(missed_half == 0);
+      CHECK(false_neighbours == 0);
+      CHECK(repeated_same == 0);
+      CHECK(same_size_once == expected_same);
+    }
+
     std::vector<std::uint32_t> order(n);
     for (std::uint32_t i = 0; i < n; ++i) order[i] = i;
     std::shuffle(order.begin(), order.end(), rng);

@@ -585,6 +585,66 @@ TEST_CASE("adaptive refinement: the linear fit from every level reproduces a lin
   CHECK(density_error <= 1e-10);  // 1e-13 of rho0
 }
 
+// distant_fit_interval: the passive particles farther than two kernel supports of their level from where it is
+// active (here the fine ones more than 2 x 2 x 0.65 dp = 2.6 dp outside the box, in a 4 dp transition zone) are
+// fitted only at the passes that cross a multiple of the interval; all the others at every pass. On the linear field
+// of the test above a fitted particle gets the field to round-off and one left out keeps the zero it was given.
+TEST_CASE("adaptive refinement: distant passive particles are fitted at their interval, the others at every pass",
+          "[refinement][apr]") {
+  AprBlock block;
+  block.params.transition_width = 4 * AprBlock::dp;
+  block.params.distant_fit_interval = 0.01;
+  Apr apr(block.system.domain(), block.boxes, block.params);
+  apr.populate(block.system);
+  auto& p = block.system.particles();
+  const auto velocity = [](const V2& x) { return V2(0.1 + 2 * x[0], -3 * x[1]); };
+  const double reach = 2 * 2 * 0.65 * AprBlock::dp;  // two supports of the level-1 particles
+  auto set_field = [&] {
+    for (std::size_t i = 0; i < p.size(); ++i) p.velocity[i] = p.passive[i] ? V2::Zero() : velocity(p.position[i]);
+  };
+  // Passive particles fitted (field to 1e-12) and left out (still zero), split by the distance to the box.
+  struct Tally {
+    std::size_t near_fitted = 0, near_left = 0, distant_fitted = 0, distant_left = 0;
+  };
+  auto tally = [&] {
+    Tally t;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      if (!p.passive[i]) continue;
+      const bool distant = apr.level_of(p.smoothing_length[i]) == 1 && !block.boxes[0].contains(p.position[i], reach);
+      const bool fitted = (p.velocity[i] - velocity(p.position[i])).norm() <= 1e-12;
+      const bool left = p.velocity[i].norm() == 0;
+      (distant ? (fitted ? t.distant_fitted : t.distant_left) : (fitted ? t.near_fitted : t.near_left)) +=
+          fitted || left ? 1 : 0;
+    }
+    return t;
+  };
+  const std::size_t passive = 64 + 4 * (16 * 16 - 8 * 8);
+  set_field();
+  apr.advance(block.system, 0.002, 0.001);  // a pass at t = 0.003 s: no multiple of 0.01 s crossed since t = 0
+  Tally t = tally();
+  INFO("pass at 0.003 s: near fitted " << t.near_fitted << ", near left " << t.near_left << ", distant fitted "
+                                       << t.distant_fitted << ", distant left " << t.distant_left);
+  CHECK(apr.last_counts().created == 0);
+  CHECK(t.near_left == 0);
+  CHECK(t.distant_fitted == 0);
+  CHECK(t.distant_left > 100);
+  CHECK(t.near_fitted + t.distant_left == passive);
+  set_field();
+  apr.advance(block.system, 0.011, 0.001);  // t = 0.012 s: 0.01 s crossed, every passive particle is fitted
+  t = tally();
+  CHECK(t.near_fitted + t.distant_fitted == passive);
+  CHECK(t.distant_fitted > 100);
+  // The interval must be non-negative, at most 1 s, and needs fixed boxes and statuses.
+  auto params = block.params;
+  params.distant_fit_interval = -1;
+  CHECK_THROWS_WITH(Apr(block.system.domain(), block.boxes, params),
+                    Catch::Contains("distant_fit_interval") && Catch::Contains("valid range"));
+  params.distant_fit_interval = 0.01;
+  params.boxes_follow_flow = true;
+  CHECK_THROWS_WITH(Apr(block.system.domain(), block.boxes, params),
+                    Catch::Contains("distant_fit_interval") && Catch::Contains("boxes_follow_flow"));
+}
+
 // limit_fit: the linear fit held within the range of the values it is fitted from. (1) On the linear field of the
 // test above every passive particle lies inside its stencil, so the limited fit is still exact. (2) On a rough field
 // (a random velocity per active particle) fitted from the other level only (interpolate_from_own_level off: at a box

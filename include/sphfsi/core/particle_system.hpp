@@ -27,6 +27,7 @@
 
 #include <cmath>
 #include <limits>
+#include <utility>
 
 namespace sphfsi {
 
@@ -145,6 +146,33 @@ class ParticleSystem {
     else visit_neighbors(i, f, [this](std::size_t a, auto&& g) { cells_.for_each_candidate_once(a, g); });
   }
 
+  /// for_each_neighbor and for_each_neighbor_once for pair loops that take only partners whose smoothing length lies
+  /// within the relative `tolerance` of h (FluidParameters::same_resolution_pairs; a particle's children): the
+  /// multi-level search skips the cells of the other sizes. Every such neighbour is passed to f, and neighbours of
+  /// other sizes may be too (the caller still tests the size); with one search grid these are for_each_neighbor and
+  /// for_each_neighbor_once.
+  template <class F>
+  void for_each_neighbor_of_size(std::size_t i, T h, T tolerance, F&& f) const {
+    if (multilevel_ && levels_.needs_levels(i)) {
+      const auto [low, high] = size_band(h, tolerance);
+      visit_neighbors(
+          i, f, [this, low, high](std::size_t a, auto&& g) { levels_.for_each_candidate_of_size(a, low, high, g); });
+    } else {
+      visit_neighbors(i, f, [this](std::size_t a, auto&& g) { cells_.for_each_candidate(a, g); });
+    }
+  }
+  template <class F>
+  void for_each_neighbor_once_of_size(std::size_t i, T h, T tolerance, F&& f) const {
+    if (multilevel_ && levels_.needs_levels(i)) {
+      const auto [low, high] = size_band(h, tolerance);
+      visit_neighbors(i, f, [this, low, high](std::size_t a, auto&& g) {
+        levels_.for_each_candidate_once_of_size(a, low, high, g);
+      });
+    } else {
+      visit_neighbors(i, f, [this](std::size_t a, auto&& g) { cells_.for_each_candidate_once(a, g); });
+    }
+  }
+
   /// One past the largest slot for_each_neighbor_once(i, f) can visit. The multi-level search keeps the storage
   /// order of the level-0 grid cells() and every neighbour in its 3^D cells, so the bound is the same.
   std::size_t neighbor_once_end(std::size_t i) const { return cells_.candidate_once_end(i); }
@@ -195,6 +223,14 @@ class ParticleSystem {
         if (r2 < radius * radius && j != i) f(j, dx, std::sqrt(r2), h_ab);
       });
     }
+  }
+
+  // Support radii of the smoothing lengths within the relative tolerance of h (a few ulps wider: the radii the search
+  // stored were rounded).
+  static std::pair<T, T> size_band(T h, T tolerance) {
+    constexpr T support = static_cast<T>(Kernel::support);
+    const T widen = T(8) * std::numeric_limits<T>::epsilon();
+    return {support * h * (T(1) - tolerance - widen), support * h * (T(1) + tolerance + widen)};
   }
 
   static std::string fmt_vec(const Vector& v) {

@@ -153,6 +153,15 @@ struct AdaptiveRefinementParameters {
   /// nothing keeps the passive layers ordered, the resolutions mix at the patch edge within a few periods, and the
   /// wave loses 4-9 % behind the patch (docs/variable-resolution.md, session 26).
   bool lagrangian_statuses{false};
+  /// Interval, s, >= 0, at which the distant passive particles are fitted: those farther than two kernel supports
+  /// (plus status_hysteresis) from every region where their level is active. No integrated particle has them as a
+  /// neighbour, nor a wall particle next to one; they only need values fresh enough to drift with the water until
+  /// they come near a box edge, where every pass fits them again. A pass fits them where it crosses a multiple of
+  /// the interval. 0: every passive particle at every pass. With local time stepping (two passes per coarse step) an
+  /// interval of about the coarse step halves their fits, a quarter to a half of a refined step's fitting work in a
+  /// wide transition zone (docs/variable-resolution.md, session 29). Not with lagrangian_statuses (the statuses do not
+  /// follow the boxes there) or boxes_follow_flow.
+  T distant_fit_interval{0};
   /// Whether the boxes move with the water along the first axis (x, a flume's direction of propagation): before each
   /// pass every box is shifted by dt times the mass-weighted mean x-velocity of the active particles of the finest
   /// level inside the boxes of that level, so that a wave's orbital motion carries the box edges with the water and
@@ -182,6 +191,11 @@ struct AdaptiveRefinementParameters {
         status_hysteresis, T(0), std::max(T(0), transition_width / base_spacing - smoothing_ratio));
     require_in_range("AdaptiveRefinementParameters::mass_account_relaxation (tau, s)", mass_account_relaxation, T(0),
                      T(1e6));
+    require_in_range("AdaptiveRefinementParameters::distant_fit_interval (s)", distant_fit_interval, T(0), T(1));
+    if (distant_fit_interval > T(0) && (lagrangian_statuses || boxes_follow_flow))
+      throw InputError(
+          "AdaptiveRefinementParameters::distant_fit_interval > 0 needs fixed boxes and statuses that follow them "
+          "(valid: lagrangian_statuses = false and boxes_follow_flow = false, or distant_fit_interval = 0)");
     if (!(bunched_fraction >= T(0.1) && bunched_fraction < occupied_fraction))
       throw InputError(
           fmt::format("AdaptiveRefinementParameters::bunched_fraction = {} is invalid: valid range is [0.1, {}) (below "
@@ -328,6 +342,10 @@ class AdaptiveRefinement {
 
   enum class Status : signed char { active, passive, removed };
 
+  // Relative spread of smoothing lengths within one level (levels are a factor 2 apart): the neighbour loops that
+  // look at one level only ask the search for that size band.
+  static constexpr T level_tolerance = T(0.25);
+
   // sum_b W(|x_a - x_b|, h) s^Dim over a square lattice of spacing s with h = smoothing_ratio s (1 to the kernel's
   // lattice error): the number density of a full, ordered support in units of 1 / s^Dim.
   template <class Kernel>
@@ -432,7 +450,6 @@ class AdaptiveRefinement {
       // relaxed: this pass's change joins the pending mass, of which the share 1 - exp(-dt / tau) is handed back
       pending_mass_ += mass_change;
       const T dt = std::max(time - last_pass_time_, T(0));
-      last_pass_time_ = time;
       mass_change = pending_mass_ * -std::expm1(-dt / params_.mass_account_relaxation);
       pending_mass_ -= mass_change;
       counts.pending_mass = std::abs(static_cast<double>(pending_mass_ / mass));
@@ -467,7 +484,15 @@ class AdaptiveRefinement {
   }
 
   // Mass of a particle of level k: rho0 (dp / 2^k)^Dim (the scene's base particles have rho0 dp^Dim).
-  T nominal_mass(int k, T rho0) const { return rho0 * std::pow(params_.base_spacing / std::pow(T(2), T(k)), T(Dim)); }
+  T nominal_mass(int k, T rho0) const { return rho0 * cell_volume(spacing_of(k)); }
+  // Spacing of level k, dp / 2^k, m, and the volume s^Dim of a lattice cell of spacing s (per-particle hot paths: no
+  // std::pow).
+  T spacing_of(int k) const { return std::ldexp(params_.base_spacing, -k); }
+  static T cell_volume(T s) {
+    T v = s;
+    for (int d = 1; d < Dim; ++d) v *= s;
+    return v;
+  }
 
   // One pass (the header comment): statuses, children in the transition zones where their place is free, the
   // particles that left their transition zone removed, the neighbour index rebuilt, the passive particles
@@ -477,7 +502,8 @@ class AdaptiveRefinement {
     const std::size_t n = p.size();
     AdaptiveRefinementCounts counts;
     if (params_.lagrangian_statuses && initial_level < 0) {  // the statuses move with the particles: fits only
-      interpolate_passive(system, counts);
+      interpolate_passive(system, counts, true);
+      last_pass_time_ = time;
       return counts;
     }
     const bool account = initial_level < 0 && (params_.conserve_mass || params_.conserve_momentum);
@@ -518,17 +544,16 @@ class AdaptiveRefinement {
     auto bunched_candidate = [&](std::size_t a) {
       return p.kind[a] == Kind::fluid && !leaving_[a] && p.passive[a] && level_[a] > level_inside(p.position[a]);
     };
-    auto close_distance = [&](std::size_t a) {
-      return params_.bunched_fraction * params_.base_spacing / std::pow(T(2), T(level_[a]));
-    };
+    auto close_distance = [&](std::size_t a) { return params_.bunched_fraction * spacing_of(level_[a]); };
     parallel_for(n, [&](std::size_t a) {
       if (!bunched_candidate(a)) return;
       const T close = close_distance(a);
       unsigned found = 0u;
-      system.for_each_neighbor(a, [&](std::size_t b, const Vector&, T r, T) {
-        if (r < close && p.kind[b] == Kind::fluid && !leaving_[b] && level_[b] == level_[a])
-          found |= !p.passive[b] ? close_active : b < a ? close_lower_passive : 0u;
-      });
+      system.for_each_neighbor_of_size(
+          a, p.smoothing_length[a], level_tolerance, [&](std::size_t b, const Vector&, T r, T) {
+            if (r < close && p.kind[b] == Kind::fluid && !leaving_[b] && level_[b] == level_[a])
+              found |= !p.passive[b] ? close_active : b < a ? close_lower_passive : 0u;
+          });
       close_[a] = static_cast<std::uint8_t>(found);
     });
     for (std::size_t a = 0; a < n; ++a) {
@@ -536,10 +561,11 @@ class AdaptiveRefinement {
       bool bunched = (close_[a] & close_active) != 0;
       if (!bunched) {  // a close passive one in a lower slot: bunched if it was not removed itself
         const T close = close_distance(a);
-        system.for_each_neighbor(a, [&](std::size_t b, const Vector&, T r, T) {
-          bunched = bunched || (r < close && p.kind[b] == Kind::fluid && !leaving_[b] && level_[b] == level_[a] &&
-                                p.passive[b] && b < a);
-        });
+        system.for_each_neighbor_of_size(
+            a, p.smoothing_length[a], level_tolerance, [&](std::size_t b, const Vector&, T r, T) {
+              bunched = bunched || (r < close && p.kind[b] == Kind::fluid && !leaving_[b] && level_[b] == level_[a] &&
+                                    p.passive[b] && b < a);
+            });
       }
       if (!bunched) continue;
       removals_.push_back(a);
@@ -555,7 +581,7 @@ class AdaptiveRefinement {
         x[d] += ((c >> d) & 1u) ? T(2) * params_.split_offset * spacing : -T(2) * params_.split_offset * spacing;
       return x;
     };
-    auto child_spacing = [&](int k) { return T(0.5) * params_.base_spacing / std::pow(T(2), T(k)); };
+    auto child_spacing = [&](int k) { return spacing_of(k + 1); };
     free_children_.assign(n, 0);
     parallel_for(n, [&](std::size_t a) {
       if (p.kind[a] != Kind::fluid || leaving_[a]) return;
@@ -573,11 +599,12 @@ class AdaptiveRefinement {
       }
       if (wanted == 0u) return;
       unsigned taken = 0u;
-      system.for_each_neighbor(a, [&](std::size_t b, const Vector&, T, T) {
-        if (p.kind[b] != Kind::fluid || leaving_[b] || level_[b] != k + 1) return;
-        for (std::size_t c = 0; c < children; ++c)
-          if ((p.position[b] - place[c]).squaredNorm() < gap2) taken |= 1u << c;
-      });
+      system.for_each_neighbor_of_size(a, T(0.5) * p.smoothing_length[a], level_tolerance,
+                                       [&](std::size_t b, const Vector&, T, T) {
+                                         if (p.kind[b] != Kind::fluid || leaving_[b] || level_[b] != k + 1) return;
+                                         for (std::size_t c = 0; c < children; ++c)
+                                           if ((p.position[b] - place[c]).squaredNorm() < gap2) taken |= 1u << c;
+                                       });
       free_children_[a] = static_cast<std::uint8_t>(wanted & ~taken);
     });
     created_.clear();
@@ -619,8 +646,12 @@ class AdaptiveRefinement {
         });
       });
     }
-    interpolate_passive(system, counts);
+    const T interval = params_.distant_fit_interval;
+    interpolate_passive(system, counts,
+                        initial_level >= 0 || !(interval > T(0)) ||
+                            std::floor(time / interval) != std::floor(last_pass_time_ / interval));
     if (account) balance(system, before, time, counts);
+    last_pass_time_ = time;
     return counts;
   }
 
@@ -691,7 +722,7 @@ class AdaptiveRefinement {
   // (fit(); the other levels', and with interpolate_from_own_level their own level's too: the header comment), then
   // their masses. Reads active particles only and writes passive ones only, so the slots can be processed in
   // parallel in place.
-  void interpolate_passive(System& system, AdaptiveRefinementCounts& counts) {
+  void interpolate_passive(System& system, AdaptiveRefinementCounts& counts, bool fit_distant) {
     auto& p = system.particles();
     const auto& kernel = system.kernel();
     const std::size_t n = p.size();
@@ -707,6 +738,7 @@ class AdaptiveRefinement {
     const bool from_volume = params_.passive_mass_from_volume;
     parallel_for(n, [&](std::size_t a) {
       if (p.kind[a] != Kind::fluid || !p.passive[a]) return;
+      if (!fit_distant && distant(p.position[a], level_[a])) return;
       const T h = p.smoothing_length[a];
       T number_density = kernel.value(T(0), h);
       const bool found = fit(
@@ -723,11 +755,23 @@ class AdaptiveRefinement {
         p.mass[a] = nominal_mass(level_[a], rho0);
         return;
       }
-      const T spacing = params_.base_spacing / std::pow(T(2), T(level_[a]));
       p.mass[a] = nominal_mass(level_[a], rho0) *
-                  std::min(T(1), lattice_number_density_ / (number_density * std::pow(spacing, T(Dim))));
+                  std::min(T(1), lattice_number_density_ / (number_density * cell_volume(spacing_of(level_[a]))));
     });
     for (std::uint8_t m : missing_) counts.uninterpolated += m;
+  }
+
+  // Whether a passive particle of level k at x lies farther than two kernel supports of its level (plus the status
+  // hysteresis) from every region where level k is active (AdaptiveRefinementParameters::distant_fit_interval):
+  // a finer particle outside the boxes of its level by more than that, or a coarser one deeper than that inside a
+  // finer box.
+  bool distant(const Vector& x, int k) const {
+    const T reach = T(2 * System::kernel_type::support) * params_.smoothing_ratio * spacing_of(k) +
+                    params_.status_hysteresis * params_.base_spacing;
+    const int inside = level_inside(x);
+    if (k > inside) return highest_level(x, reach) < k;
+    if (k < inside) return highest_level(x, -reach) > k;
+    return false;
   }
 
   void check_walls(const System& system) const {
@@ -767,7 +811,7 @@ class AdaptiveRefinement {
   ParticleShifting<System> shifter_;
   AdaptiveRefinementCounts last_{}, total_{};
   T pending_mass_{0};                        // the relaxed mass account's mass still to hand back
-  T last_pass_time_{0};                      // time of the last pass (the relaxed mass account's dt)
+  T last_pass_time_{0};                      // time of the last pass (the relaxed mass account's dt, distant fits)
   T box_displacement_{0};                    // how far the boxes moved along x (boxes_follow_flow), m
   std::vector<int> level_;                   // per slot of the pass: level
   std::vector<std::uint8_t> missing_;        // per slot: passive without an active neighbour of another level

@@ -485,7 +485,7 @@ class WcsphFluid {
     Vector acc = Vector::Zero(), xsph = Vector::Zero();
     T drho = T(0), mu_max = T(0);
 
-    system.for_each_neighbor_once(a, [&](std::size_t b, const Vector& dx, T r, T h) {
+    const auto interact = [&](std::size_t b, const Vector& dx, T r, T h) {
       const Kind kb = kind[b];
       const bool fluid_b = kb == Kind::fluid;
       if (kb == Kind::solid || !(fluid_a || fluid_b)) return;  // wall-wall pairs do not interact
@@ -564,7 +564,10 @@ class WcsphFluid {
         }
       }
       if (stepping_b) partner.add_density_rate(b, drho_b);
-    });
+    };
+    // One resolution per pair: the multi-level search skips the cells of the other sizes.
+    if (same_resolution) system.for_each_neighbor_once_of_size(a, h_a, same_h_tolerance, interact);
+    else system.for_each_neighbor_once(a, interact);
     if (frozen_a) return;
     p.acceleration[a] += acc;
     p.density_rate[a] += drho;

@@ -98,6 +98,7 @@ class MultilevelCellList {
       offset += total;
       level.scale = std::ldexp(T(1), l);
       level.radius = T(0);
+      level.min_radius = std::numeric_limits<T>::max();
       level.count = 0;
       level.first.fill(std::numeric_limits<std::int64_t>::max());
       level.last.fill(-1);
@@ -121,6 +122,7 @@ class MultilevelCellList {
       scratch_coordinates_[i] = y;
       scratch_radius_[i] = r;
       level.radius = std::max(level.radius, r);
+      level.min_radius = std::min(level.min_radius, r);
       ++level.count;
       for (int d = 0; d < Dim; ++d) {
         level.first[d] = std::min(level.first[d], c[d]);
@@ -200,6 +202,18 @@ class MultilevelCellList {
     visit<true>(i, f);
   }
 
+  /// for_each_candidate and for_each_candidate_once restricted to the levels that hold a particle whose support
+  /// radius lies in [r_low, r_high]: pair loops that take partners of one size only (same_resolution_pairs) skip the
+  /// cells of the other sizes. Candidates of other sizes that share a level with those are still passed to f.
+  template <class F>
+  void for_each_candidate_of_size(std::size_t i, T r_low, T r_high, F&& f) const {
+    visit<false>(i, f, r_low, r_high);
+  }
+  template <class F>
+  void for_each_candidate_once_of_size(std::size_t i, T r_low, T r_high, F&& f) const {
+    visit<true>(i, f, r_low, r_high);
+  }
+
   /// Number of levels of the last build (1: single grid).
   int levels() const noexcept { return levels_; }
   /// Cell edge of level l, m.
@@ -213,6 +227,7 @@ class MultilevelCellList {
     std::size_t offset = 0;                         // first cell in the flat index
     T scale{1};                                     // 2^l: level-0 cell units to level-l cell units
     T radius{0};                                    // largest support radius of the level's particles, m
+    T min_radius{0};                                // smallest support radius of the level's particles, m
     std::size_t count = 0;                          // particles in the level
     std::array<std::int64_t, Dim> first{}, last{};  // the cells the level's particles occupy: a bounding box
   };
@@ -244,9 +259,11 @@ class MultilevelCellList {
   // rounding of x -> y must not drop a cell). With `once`, only j > i: the slots follow the level-0 cells in
   // lexicographic order (z, y, x), so the cells whose level-0 cell comes before i's hold only slots < i and are
   // skipped without being read (a level-l cell c lies in the level-0 cell c / 2^l); in i's own level-0 cell the
-  // ranges are clipped at i + 1.
+  // ranges are clipped at i + 1. Levels none of whose particles has a support radius in [r_low, r_high] are skipped.
   template <bool once, class F>
-  void visit(std::size_t i, F f) const {  // f by value: a local copy whose state the compiler can keep in registers
+  void visit(std::size_t i, F f, T r_low = T(0),
+             T r_high = std::numeric_limits<T>::infinity()) const {  // f by value: a local copy whose state the
+                                                                     // compiler can keep in registers
     const Vector y = coordinates_[i];
     const T ri = radius_[i];
     const T slack = T(8) * std::numeric_limits<T>::epsilon() * (y.maxCoeff() + T(2));
@@ -255,7 +272,7 @@ class MultilevelCellList {
     for (int d = 0; d < Dim; ++d) own[d] = std::clamp<std::int64_t>(floor_index(y[d]), 0, level_[0].cells[d] - 1);
     for (int l = 0; l < levels_; ++l) {
       const Level& level = level_[l];
-      if (level.count == 0) continue;
+      if (level.count == 0 || level.radius < r_low || level.min_radius > r_high) continue;
       const T reach = T(0.5) * (ri + level.radius) * inverse_coarse_cell_size_ + slack;
       const T scale = level.scale;
       // The box's cells, clipped to the cells the level occupies (a level confined to a region costs nothing to

@@ -85,6 +85,9 @@ struct PlantRefinement {
   bool lagrangian{false};
   /// AdaptiveRefinementParameters::boxes_follow_flow: the box moves along x with the fine water in it
   bool follow_flow{false};
+  /// AdaptiveRefinementParameters::distant_fit_interval, s: the passive particles far from the box edges fitted at
+  /// this interval only (0: at every pass)
+  T distant_fit_interval{T(0)};
 };
 
 /// The Posidonia flume: waves, resolution, plants and blade model (lengths in m).
@@ -215,6 +218,7 @@ struct PosidoniaFlume {
     a.conserve_mass = refinement.mass_account;
     a.lagrangian_statuses = refinement.lagrangian;
     a.boxes_follow_flow = refinement.follow_flow;
+    a.distant_fit_interval = refinement.distant_fit_interval;
     return a;
   }
   /// The real blade as a line of rod nodes (rod, drag), not a continuum of particle rows (scaled, equivalent).
