@@ -155,7 +155,8 @@ scenes::PosidoniaFlume<T> converted(const scenes::PosidoniaFlume<double>& s) {
                   s.refinement.mass_account,
                   s.refinement.lagrangian,
                   s.refinement.follow_flow,
-                  T(s.refinement.distant_fit_interval)};
+                  T(s.refinement.distant_fit_interval),
+                  s.refinement.local_account};
   return c;
 }
 
@@ -291,6 +292,18 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
     tips_csv.emplace(dir / "tips.csv", tip_columns,
                      fmt::format("plant tip (top row mean) displacement (m); plant centre lines x = {} m",
                                  fmt::join(layout.plant_x, ", ")));
+  // the current profile along the flume: the Eulerian horizontal velocity at the blade's four profile heights
+  // (l/8 ... 7l/8 above the bed) every 0.1 m from 0.5 to 1.9 m, so that the mean current near the bed can be followed
+  // into and through a refinement box
+  std::vector<double> current_x;
+  for (int i = 5; i <= 19; ++i) current_x.push_back(0.1 * i);
+  std::vector<std::string> current_columns{"t"};
+  for (double x : current_x)
+    for (double f : profile_heights)
+      current_columns.push_back(fmt::format("u_x{:.2f}_z{:.4f}", x, f * double(scene.blade_length())));
+  io::CsvWriter currents_csv(dir / "currents.csv", current_columns,
+                             "Eulerian horizontal velocity (m/s) of the active fluid at x (m, first number) and height "
+                             "above the bed (m, second number)");
   // the active fluid's volume sum m / rho and mass, per unit width: a refinement box's status changes move water
   // between the active and the passive fluid, and its mass account hands the difference back at fixed density
   io::CsvWriter volume_csv(dir / "fluid_volume.csv", {"t", "active_volume", "active_mass"},
@@ -334,6 +347,13 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
       if (double(sm.time()) + 1e-9 >= next_sample) {
         gauges.sample(sm.system(), sm.time());
         record_volume(sm.system(), double(sm.time()));
+        {
+          std::vector<double> row{double(sm.time())};
+          for (double x : current_x)
+            for (double f : profile_heights)
+              row.push_back(eulerian_velocity(sm.system(), Vec<2, T>(T(x), T(f) * scene.blade_length())));
+          currents_csv.write_row(row);
+        }
         if constexpr (WithPlants) {
           std::vector<double> row{double(sm.time())};
           times.push_back(double(sm.time()));
@@ -882,6 +902,10 @@ int main(int argc, char** argv) try {
       "follow-flow", false,
       "refinement: the box moves along x with the mean velocity of the fine water in it (at most transition - h/dp "
       "base spacings): on | off");
+  s.refinement.local_account = cli.get_switch(
+      "local-account", false,
+      "refinement: the mass account hands each status change's mass back to the active fluid within its kernel "
+      "support (else to the band along the box edges): on | off");
   s.refinement.distant_fit_interval = cli.get_number(
       "distant-fit", 0,
       "refinement: the passive particles farther than two kernel supports from where their resolution is active are "

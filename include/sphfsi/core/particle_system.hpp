@@ -154,7 +154,8 @@ class ParticleSystem {
   template <class F>
   void for_each_neighbor_of_size(std::size_t i, T h, T tolerance, F&& f) const {
     if (multilevel_ && levels_.needs_levels(i)) {
-      const auto [low, high] = size_band(h, tolerance);
+      const std::pair<T, T> band = size_band(h, tolerance);  // no structured binding: clang < 16 cannot capture one
+      const T low = band.first, high = band.second;
       visit_neighbors(
           i, f, [this, low, high](std::size_t a, auto&& g) { levels_.for_each_candidate_of_size(a, low, high, g); });
     } else {
@@ -164,7 +165,8 @@ class ParticleSystem {
   template <class F>
   void for_each_neighbor_once_of_size(std::size_t i, T h, T tolerance, F&& f) const {
     if (multilevel_ && levels_.needs_levels(i)) {
-      const auto [low, high] = size_band(h, tolerance);
+      const std::pair<T, T> band = size_band(h, tolerance);  // no structured binding: clang < 16 cannot capture one
+      const T low = band.first, high = band.second;
       visit_neighbors(i, f, [this, low, high](std::size_t a, auto&& g) {
         levels_.for_each_candidate_once_of_size(a, low, high, g);
       });
