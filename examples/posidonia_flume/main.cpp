@@ -155,8 +155,7 @@ scenes::PosidoniaFlume<T> converted(const scenes::PosidoniaFlume<double>& s) {
                   s.refinement.mass_account,
                   s.refinement.lagrangian,
                   s.refinement.follow_flow,
-                  T(s.refinement.distant_fit_interval),
-                  s.refinement.local_account};
+                  T(s.refinement.distant_fit_interval)};
   return c;
 }
 
@@ -902,10 +901,6 @@ int main(int argc, char** argv) try {
       "follow-flow", false,
       "refinement: the box moves along x with the mean velocity of the fine water in it (at most transition - h/dp "
       "base spacings): on | off");
-  s.refinement.local_account = cli.get_switch(
-      "local-account", false,
-      "refinement: the mass account hands each status change's mass back to the active fluid within its kernel "
-      "support (else to the band along the box edges): on | off");
   s.refinement.distant_fit_interval = cli.get_number(
       "distant-fit", 0,
       "refinement: the passive particles farther than two kernel supports from where their resolution is active are "

@@ -12,8 +12,6 @@
 
 #include <cmath>
 #include <filesystem>
-#include <limits>
-#include <map>
 #include <random>
 #include <set>
 
@@ -871,67 +869,6 @@ TEST_CASE("adaptive refinement: the mass account conserves the active mass to ro
       CHECK(apr.total_counts().mass_correction == 0);
     }
   }
-}
-
-// local_mass_account: each status change's mass goes to (or comes from) the active particles within its kernel
-// support. The disordered block drifts through the box as above: the active mass is kept to round-off, the band
-// account is left nothing to do (every change has active neighbours: its largest correction is round-off), and a
-// particle whose mass changed in a pass lies within a kernel support (2 h_ab, at most 2 x 1.3 dp) of one whose status
-// changed in it.
-TEST_CASE("adaptive refinement: the local mass account keeps the active mass and hands it back where it changed",
-          "[refinement][apr]") {
-  AprBlock block;
-  block.params.conserve_momentum = false;
-  block.params.local_mass_account = true;
-  auto& p = block.system.particles();
-  const V2 u(0.5, 0);
-  block.disorder();
-  for (std::size_t i = 0; i < p.size(); ++i) p.velocity[i] = u;
-  const double mass0 = fluid_totals(p).mass;
-  Apr apr(block.system.domain(), block.boxes, block.params);
-  apr.populate(block.system);
-  std::map<std::uint32_t, double> mass_before;
-  std::map<std::uint32_t, bool> passive_before;
-  auto remember = [&] {
-    mass_before.clear();
-    passive_before.clear();
-    for (std::size_t i = 0; i < p.size(); ++i) {
-      mass_before[p.id[i]] = p.mass[i];
-      passive_before[p.id[i]] = p.passive[i];
-    }
-  };
-  remember();
-  double worst_mass = 0, farthest = 0;
-  std::size_t rescaled = 0;
-  const std::size_t changes = block.drift(apr, 0.2 * AprBlock::dp / u[0], [&] {
-    worst_mass = std::max(worst_mass, std::abs(apr.active_mass_momentum(block.system).first - mass0) / mass0);
-    std::vector<V2> changed;
-    for (std::size_t i = 0; i < p.size(); ++i)
-      if (passive_before.count(p.id[i]) && passive_before[p.id[i]] != bool(p.passive[i]))
-        changed.push_back(p.position[i]);
-    for (std::size_t i = 0; i < p.size(); ++i) {
-      if (p.passive[i] || !passive_before.count(p.id[i]) || passive_before[p.id[i]]) continue;  // active throughout
-      // (the band account still rescales by round-off, 1e-15)
-      if (std::abs(p.mass[i] - mass_before[p.id[i]]) <= 1e-12 * mass_before[p.id[i]]) continue;
-      ++rescaled;
-      double nearest = std::numeric_limits<double>::infinity();
-      for (const V2& x : changed) nearest = std::min(nearest, (p.position[i] - x).norm());
-      farthest = std::max(farthest, nearest);
-    }
-    remember();
-  });
-  INFO("largest |dM| / M " << worst_mass << ", band correction " << apr.total_counts().mass_correction
-                           << ", status changes " << changes << ", rescaled " << rescaled << ", farthest "
-                           << farthest / AprBlock::dp << " dp");
-  CHECK(changes > 0);
-  CHECK(rescaled > 0);
-  CHECK(worst_mass <= 1e-12);
-  CHECK(apr.total_counts().mass_correction <= 1e-13);
-  CHECK(farthest <= 2 * 1.3 * AprBlock::dp);
-  // without conserve_mass the option is refused
-  auto params = block.params;
-  params.conserve_mass = false;
-  CHECK_THROWS_WITH(Apr(block.system.domain(), block.boxes, params), Catch::Contains("local_mass_account"));
 }
 
 // account_over_all_fluid: the mass account hands its changes to every active fluid particle. The block drifts as above;

@@ -113,13 +113,6 @@ struct AdaptiveRefinementParameters {
   /// changes a particle's volume: near the edges it is a local source of volume, timed by the status changes, that a
   /// wave's own motion paces; spread over all the fluid it raises the level uniformly.
   bool account_over_all_fluid{false};
-  /// Whether the mass account hands each status change's mass back where it happened: a particle that became active
-  /// with mass m takes m from the active fluid particles within its kernel support, one that became passive gives its
-  /// m to them, shared in proportion to m_b W_ab; so each change is neutral in mass and, at the local density, in
-  /// volume. The band account (conserve_mass) then finds only what no active neighbour could take. Measured: the band
-  /// account's rescale at fixed density, paced by the waves, drives a mean current around a flume's box
-  /// (docs/variable-resolution.md, session 29). Needs conserve_mass.
-  bool local_mass_account{false};
   /// Relaxation time tau of the mass account, s, >= 0. 0: each pass hands back at once the mass it changed. > 0: the
   /// changes go to a pending mass, of which each pass hands back the share 1 - exp(-dt / tau) (dt since the last
   /// pass), so the active mass plus the pending mass is conserved to round-off and the pending mass stays of the
@@ -199,10 +192,6 @@ struct AdaptiveRefinementParameters {
     require_in_range("AdaptiveRefinementParameters::mass_account_relaxation (tau, s)", mass_account_relaxation, T(0),
                      T(1e6));
     require_in_range("AdaptiveRefinementParameters::distant_fit_interval (s)", distant_fit_interval, T(0), T(1));
-    if (local_mass_account && !conserve_mass)
-      throw InputError(
-          "AdaptiveRefinementParameters::local_mass_account needs conserve_mass (valid: conserve_mass = true, or "
-          "local_mass_account = false)");
     if (distant_fit_interval > T(0) && (lagrangian_statuses || boxes_follow_flow))
       throw InputError(
           "AdaptiveRefinementParameters::distant_fit_interval > 0 needs fixed boxes and statuses that follow them "
@@ -494,28 +483,6 @@ class AdaptiveRefinement {
     counts.momentum_correction = static_cast<double>(shift.norm());
   }
 
-  // The local mass account (AdaptiveRefinementParameters::local_mass_account): each particle in changed_ (its status
-  // just changed) hands its mass back to, or takes it from, the active fluid particles within its kernel support that
-  // kept their status, in proportion to m_b W_ab. In slot order (a change's neighbours may change themselves).
-  void hand_back_locally(System& system) {
-    auto& p = system.particles();
-    const auto& kernel = system.kernel();
-    for (std::size_t a : changed_) {
-      const T mass = p.passive[a] ? p.mass[a] : -p.mass[a];  // what the active fluid must get back
-      T weight = T(0);
-      system.for_each_neighbor(a, [&](std::size_t b, const Vector&, T r, T h) {
-        if (p.kind[b] == Kind::fluid && !p.passive[b] && !changed(b)) weight += p.mass[b] * kernel.value(r, h);
-      });
-      if (!(weight > T(0))) continue;  // left to the band account
-      const T share = mass / weight;
-      system.for_each_neighbor(a, [&](std::size_t b, const Vector&, T r, T h) {
-        if (p.kind[b] == Kind::fluid && !p.passive[b] && !changed(b))
-          p.mass[b] += share * p.mass[b] * kernel.value(r, h);
-      });
-    }
-  }
-  bool changed(std::size_t b) const { return std::binary_search(changed_.begin(), changed_.end(), b); }
-
   // Mass of a particle of level k: rho0 (dp / 2^k)^Dim (the scene's base particles have rho0 dp^Dim).
   T nominal_mass(int k, T rho0) const { return rho0 * cell_volume(spacing_of(k)); }
   // Spacing of level k, dp / 2^k, m, and the volume s^Dim of a lattice cell of spacing s (per-particle hot paths: no
@@ -540,8 +507,6 @@ class AdaptiveRefinement {
       return counts;
     }
     const bool account = initial_level < 0 && (params_.conserve_mass || params_.conserve_momentum);
-    const bool local_account = initial_level < 0 && params_.conserve_mass && params_.local_mass_account;
-    changed_.clear();
     const auto before = account ? active_mass_momentum(system) : std::pair{T(0), Vector::Zero().eval()};
     // 1. Statuses; particles finer than every box within transition_width of them are removed.
     const T hysteresis = params_.status_hysteresis * params_.base_spacing;
@@ -566,11 +531,9 @@ class AdaptiveRefinement {
       }
       if (passive != p.passive[a]) {
         ++(passive ? counts.deactivated : counts.activated);
-        if (local_account) changed_.push_back(a);
       }
       p.passive[a] = passive;
     }
-    if (local_account) hand_back_locally(system);
     // Passive particles of a transition zone that bunched up (closer than bunched_fraction of their spacing to a
     // particle of their level that stays: an active one, or a passive one in a lower slot) are removed too. In slot
     // order, since a removal frees the particles above; the neighbours are first screened in parallel against the
@@ -859,7 +822,6 @@ class AdaptiveRefinement {
   std::vector<std::uint8_t> close_;          // per slot of the pass: flags of the bunched test
   std::vector<std::uint8_t> free_children_;  // per slot of the pass: bit c set if child c is created
   std::vector<std::size_t> edge_;            // slots of the active particles near a box edge (the accounts)
-  std::vector<std::size_t> changed_;         // slots whose status the pass changed (local mass account), ascending
 };
 
 }  // namespace sphfsi

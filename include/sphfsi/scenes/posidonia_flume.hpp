@@ -88,8 +88,6 @@ struct PlantRefinement {
   /// AdaptiveRefinementParameters::distant_fit_interval, s: the passive particles far from the box edges fitted at
   /// this interval only (0: at every pass)
   T distant_fit_interval{T(0)};
-  /// AdaptiveRefinementParameters::local_mass_account: each status change's mass handed back where it happened
-  bool local_account{false};
 };
 
 /// The Posidonia flume: waves, resolution, plants and blade model (lengths in m).
@@ -221,7 +219,6 @@ struct PosidoniaFlume {
     a.lagrangian_statuses = refinement.lagrangian;
     a.boxes_follow_flow = refinement.follow_flow;
     a.distant_fit_interval = refinement.distant_fit_interval;
-    a.local_mass_account = refinement.local_account;
     return a;
   }
   /// The real blade as a line of rod nodes (rod, drag), not a continuum of particle rows (scaled, equivalent).
