@@ -158,9 +158,9 @@ struct AdaptiveRefinementParameters {
   /// neighbour, nor a wall particle next to one; they only need values fresh enough to drift with the water until
   /// they come near a box edge, where every pass fits them again. A pass fits them where it crosses a multiple of
   /// the interval. 0: every passive particle at every pass. With local time stepping (two passes per coarse step) an
-  /// interval of about the coarse step halves their fits, a quarter to a half of a refined step's fitting work in a
-  /// wide transition zone (docs/variable-resolution.md, session 29). Not with lagrangian_statuses (the statuses do not
-  /// follow the boxes there) or boxes_follow_flow.
+  /// interval of about the coarse step fits them about once per coarse step: measured, 15 % less wall time in the
+  /// refined Posidonia flume (docs/variable-resolution.md, session 29). Not with lagrangian_statuses (the statuses do
+  /// not follow the boxes there) or boxes_follow_flow.
   T distant_fit_interval{0};
   /// Whether the boxes move with the water along the first axis (x, a flume's direction of propagation): before each
   /// pass every box is shifted by dt times the mass-weighted mean x-velocity of the active particles of the finest
