@@ -260,10 +260,9 @@ class MultilevelCellList {
   // lexicographic order (z, y, x), so the cells whose level-0 cell comes before i's hold only slots < i and are
   // skipped without being read (a level-l cell c lies in the level-0 cell c / 2^l); in i's own level-0 cell the
   // ranges are clipped at i + 1. Levels none of whose particles has a support radius in [r_low, r_high] are skipped.
+  // f is taken by value: a local copy whose state the compiler can keep in registers.
   template <bool once, class F>
-  void visit(std::size_t i, F f, T r_low = T(0),
-             T r_high = std::numeric_limits<T>::infinity()) const {  // f by value: a local copy whose state the
-                                                                     // compiler can keep in registers
+  void visit(std::size_t i, F f, T r_low = T(0), T r_high = std::numeric_limits<T>::infinity()) const {
     const Vector y = coordinates_[i];
     const T ri = radius_[i];
     const T slack = T(8) * std::numeric_limits<T>::epsilon() * (y.maxCoeff() + T(2));
