@@ -155,7 +155,9 @@ scenes::PosidoniaFlume<T> converted(const scenes::PosidoniaFlume<double>& s) {
                   s.refinement.mass_account,
                   s.refinement.lagrangian,
                   s.refinement.follow_flow,
-                  T(s.refinement.distant_fit_interval)};
+                  T(s.refinement.distant_fit_interval),
+                  T(s.refinement.edge_dither),
+                  s.refinement.wall_faces};
   return c;
 }
 
@@ -905,6 +907,14 @@ int main(int argc, char** argv) try {
       "distant-fit", 0,
       "refinement: the passive particles farther than two kernel supports from where their resolution is active are "
       "fitted at this interval only, s (0: at every pass), [0, 1]");
+  s.refinement.edge_dither = cli.get_number(
+      "edge-dither", 0,
+      "refinement: each particle sees the box edges moved by its own fixed offset, uniform over this width, base "
+      "spacings, [0, 2] (a water column then changes status particle by particle)");
+  s.refinement.wall_faces = cli.get_switch(
+      "wall-faces", true,
+      "refinement: the box's bed face (and its top above the crests) counts as a wall, not an edge: no dither, "
+      "hysteresis or account band there (off: sessions 14-29's band along the bed): on | off");
   o.local_steps = cli.get_switch("local-steps", false,
                                  "refinement: local time stepping, the coarse fluid at twice the fine step: on | off");
   o.fine_step_margin = cli.get_number(

@@ -1147,3 +1147,110 @@ TEST_CASE("adaptive refinement: status hysteresis stops particles oscillating ac
   bad.status_hysteresis = 100;  // beyond the transition zone
   CHECK_THROWS_WITH(bad.validate(), Catch::Contains("status_hysteresis"));
 }
+
+// Dithered box edges (AdaptiveRefinementParameters::edge_dither). A 40 x 40 lattice at dp (no forces, no accounts)
+// drifts 4 dp along x, 0.05 dp per pass, across the left edge of a level-1 box that spans 32 rows (the box reaches past
+// the block's right end, so no other edge is crossed). Without dither each lattice column changes status at once: the
+// active mass follows the sawtooth +1/2, -1/2, 0, 0 columns of 32 coarse masses as the fine column at dp/4, the coarse
+// one at dp/2 and the fine one at 3 dp/4 cross (rms sqrt(1/8) = 0.354 columns, worst 1/2). With the edges dithered
+// over one dp each particle changes at its own offset, so the expected active mass is the same at every displacement
+// and what is left is the spread of the count of particles that did: variance sum p (1 - p) = 1/6 per particle of the
+// band dp wide, so the rms is sqrt((32 + 128 / 16) / 6) = 2.58 coarse masses = 0.081 columns (32 coarse and 128 fine
+// particles of a quarter of the mass in the band).
+TEST_CASE("adaptive refinement: dithered box edges let a lattice column change status particle by particle",
+          "[refinement][apr]") {
+  constexpr double dp = 0.01;
+  auto drift = [&](double dither) {
+    AprSystem system{Domain<2, double>(V2(-0.1, -0.1), V2(0.7, 0.5)), Tait<double>(1000, 20)};
+    for (int i = 0; i < 40; ++i)
+      for (int j = 0; j < 40; ++j)
+        system.particles().add(Kind::fluid, V2((i + 0.5) * dp, (j + 0.5) * dp), V2::Zero(), 1000, 1000 * dp * dp,
+                               1.3 * dp);
+    system.update_pressure();
+    AdaptiveRefinementParameters<double> params;
+    params.base_spacing = dp;
+    params.transition_width = 4 * dp;
+    params.conserve_mass = false;
+    params.conserve_momentum = false;
+    params.edge_dither = dither;
+    Apr apr(system.domain(), {{V2(8 * dp, 4 * dp), V2(0.55, 36 * dp), 1}}, params);
+    apr.populate(system);
+    auto& p = system.particles();
+    const double mass0 = apr.active_mass_momentum(system).first, column = 32 * 1000 * dp * dp;
+    double worst = 0, sum2 = 0;
+    constexpr int passes = 80;
+    for (int pass = 0; pass < passes; ++pass) {
+      for (std::size_t i = 0; i < p.size(); ++i) p.position[i][0] += 0.05 * dp;
+      system.update_neighbors(pass * 1e-3);
+      apr.advance(system, pass * 1e-3, 1e-3);
+      const double change = (apr.active_mass_momentum(system).first - mass0) / column;
+      worst = std::max(worst, std::abs(change));
+      sum2 += change * change;
+    }
+    return std::pair{worst, std::sqrt(sum2 / passes)};
+  };
+  const auto [worst_abrupt, rms_abrupt] = drift(0);
+  const auto [worst_dithered, rms_dithered] = drift(1);
+  INFO("active mass change, columns: abrupt edges worst "
+       << worst_abrupt << " rms " << rms_abrupt << "; dithered worst " << worst_dithered << " rms " << rms_dithered);
+  CHECK(worst_abrupt == Approx(0.5).epsilon(1e-9));
+  CHECK(rms_abrupt == Approx(std::sqrt(0.125)).epsilon(1e-9));
+  CHECK(rms_dithered <= 0.081 * 1.5);  // the count's spread, with the margin of one realisation's rms
+  CHECK(worst_dithered <= 0.25);       // half the sawtooth
+
+  AdaptiveRefinementParameters<double> bad;
+  bad.base_spacing = dp;
+  bad.transition_width = 4 * dp;
+  bad.edge_dither = 3;
+  CHECK_THROWS_WITH(bad.validate(), Catch::Contains("edge_dither"));
+  bad.edge_dither = 2;
+  bad.status_hysteresis = 2.5;  // 4 - 1.3 - 1 = 1.7 at most
+  CHECK_THROWS_WITH(bad.validate(), Catch::Contains("status_hysteresis"));
+}
+
+// Wall faces (RefinementBox::wall_faces): a box standing on the bottom of the block (its lower face at y = 0, where no
+// fluid crosses). With the bottom face a wall face, the particles along it keep the statuses of the box itself under
+// a dither of one dp (every fine particle in the box active, every coarse one passive), and the mass account of a
+// drift along x rescales only the particles within transition_width of the vertical faces: the fine particles of the
+// bottom row in the middle of the box (more than 2.5 dp from them) keep their masses. With the bottom face open, the
+// dither moves it: some bottom-row particles take the other status, and the account band takes in the bottom row.
+TEST_CASE("adaptive refinement: wall faces of a box are not dithered and take no account band", "[refinement][apr]") {
+  constexpr double dp = AprBlock::dp;
+  for (const bool wall : {true, false}) {
+    AprBlock block;
+    block.boxes = {{V2(8 * dp, 0), V2(16 * dp, 12 * dp), 1}};
+    if (wall) block.boxes[0].wall_faces = 0b0100u;  // the lower face along y
+    block.params.edge_dither = 1;
+    auto& p = block.system.particles();
+    for (std::size_t i = 0; i < p.size(); ++i) p.velocity[i] = V2(0.5, 0);
+    Apr apr(block.system.domain(), block.boxes, block.params);
+    apr.populate(block.system);
+    // the particles of the bottom row (y < dp) well inside the box along x: their status against the box's own
+    auto bottom_middle = [&](std::size_t i) {
+      return p.position[i][1] < dp && p.position[i][0] > 10.5 * dp && p.position[i][0] < 12.5 * dp;
+    };
+    std::size_t other_status = 0;
+    std::vector<std::pair<std::uint32_t, double>> fine_bottom;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      if (!bottom_middle(i)) continue;
+      const bool fine = apr.level_of(p.smoothing_length[i]) == 1;
+      other_status += bool(p.passive[i]) == fine;
+      if (fine) fine_bottom.emplace_back(p.id[i], p.mass[i]);
+    }
+    REQUIRE(fine_bottom.size() >= 4);
+    const std::size_t changes = block.drift(apr, 0.05 * dp / 0.5, [] {});  // 1 dp: they stay 2.5 dp from the faces
+    std::size_t rescaled = 0;
+    for (const auto& [id, mass] : fine_bottom) rescaled += p.mass[p.slot_of_id(id)] != mass;
+    INFO((wall ? "wall face" : "open face") << ": bottom-row particles with the other status " << other_status
+                                            << ", fine ones rescaled " << rescaled << " of " << fine_bottom.size());
+    CHECK(changes > 0);
+    CHECK(apr.total_counts().mass_correction > 0);
+    if (wall) {
+      CHECK(other_status == 0);
+      CHECK(rescaled == 0);
+    } else {
+      CHECK(other_status > 0);
+      CHECK(rescaled > 0);  // the active ones (a dithered one may have turned passive)
+    }
+  }
+}

@@ -42,6 +42,10 @@
 // the passive values. The refined region is then a patch of water that moves with the flow, with no status changes,
 // children or removals, for oscillatory flows whose particles come back (waves).
 //
+// Dithered edges (edge_dither): each particle sees the box edges moved by its own fixed offset (a hash of its id), so
+// that a column of particles crossing an edge together (a lattice; the water column of a wave's orbital motion)
+// changes status particle by particle, not all at once.
+//
 // Boxes that follow the flow (boxes_follow_flow): the boxes move along x with the mean velocity of the finest active
 // fluid in them, so that a wave's orbital motion carries the edges with the water.
 //
@@ -82,6 +86,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <limits>
 #include <utility>
@@ -142,6 +147,15 @@ struct AdaptiveRefinementParameters {
   /// edge by less (the orbital motion of a wave, the jitter of the particles) does not change it at every pass; it
   /// changes once the particle is this far past the edge. 0: the status follows the position exactly.
   T status_hysteresis{0};
+  /// Dither of the box edges for the statuses, in base spacings, [0, 2]: each fluid particle sees every box edge moved
+  /// outwards by its own fixed offset, uniform in [-edge_dither / 2, edge_dither / 2) base spacings (a hash of its id,
+  /// so the same in every run, thread count and restart). On an abrupt edge a lattice column (or a whole water column
+  /// in a wave's horizontal orbital motion) changes status at once: the active mass then swings by up to half a
+  /// coarse column per edge as the columns of the two levels cross it in turn (a sawtooth in the displacement, paced by
+  /// the wave). Dithered over a whole base spacing, a column changes status particle by particle and the expected
+  /// active mass no longer depends on where the lattice stands against the edge (dithering, as in signal
+  /// quantisation). 0: the edges are where the boxes say.
+  T edge_dither{0};
   /// Whether the statuses populate() gave are carried by the particles from then on (Lagrangian statuses): after
   /// populate() a pass changes no status, creates no child and removes no particle; it only fits the passive
   /// particles' values. The refined region is then a patch of water that moves with the flow (the particles of each
@@ -185,10 +199,12 @@ struct AdaptiveRefinementParameters {
     require_in_range("AdaptiveRefinementParameters::occupied_fraction", occupied_fraction, T(0.25), T(1));
     // a fine particle kept active up to the hysteresis outside its box needs its whole support of fine particles
     // (2 h of level 1 = smoothing_ratio base spacings) inside the transition zone
+    require_in_range("AdaptiveRefinementParameters::edge_dither (base spacings)", edge_dither, T(0), T(2));
     require_in_range(
         "AdaptiveRefinementParameters::status_hysteresis (base spacings; at most transition_width / "
-        "base_spacing - smoothing_ratio)",
-        status_hysteresis, T(0), std::max(T(0), transition_width / base_spacing - smoothing_ratio));
+        "base_spacing - smoothing_ratio - edge_dither / 2)",
+        status_hysteresis, T(0),
+        std::max(T(0), transition_width / base_spacing - smoothing_ratio - T(0.5) * edge_dither));
     require_in_range("AdaptiveRefinementParameters::mass_account_relaxation (tau, s)", mass_account_relaxation, T(0),
                      T(1e6));
     require_in_range("AdaptiveRefinementParameters::distant_fit_interval (s)", distant_fit_interval, T(0), T(1));
@@ -414,11 +430,24 @@ class AdaptiveRefinement {
     return level;
   }
 
-  Status status(int k, const Vector& x) const {
-    const int inside = level_inside(x);
-    if (k == inside) return Status::active;
-    if (k < inside) return Status::passive;
-    return k <= level_near(x) ? Status::passive : Status::removed;
+  // Highest level of the boxes containing x when their open faces (not RefinementBox::wall_faces) move by margin.
+  int open_level(const Vector& x, T margin) const {
+    int level = 0;
+    for (const Box& b : boxes_)
+      if (b.level > level && b.contains_within_open_faces(x, margin)) level = b.level;
+    return level;
+  }
+
+  // The particle's own offset of the box edges (edge_dither), m: uniform in [-1/2, 1/2) edge_dither base spacings,
+  // from the splitmix64 finaliser of its id (Steele, Lea & Flood 2014).
+  T dither_offset(std::uint32_t id) const {
+    if (!(params_.edge_dither > T(0))) return T(0);
+    std::uint64_t z = std::uint64_t(id) + 0x9e3779b97f4a7c15ull;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    z ^= z >> 31;
+    const T unit = T(z >> 11) * T(1.0 / 9007199254740992.0);  // [0, 1), 53 bits
+    return (unit - T(0.5)) * params_.edge_dither * params_.base_spacing;
   }
 
   void accumulate(const AdaptiveRefinementCounts& c) {
@@ -434,7 +463,7 @@ class AdaptiveRefinement {
 
   // Whether x lies within transition_width of a box edge (on either side): the band where statuses change.
   bool near_box_edge(const Vector& x) const {
-    return highest_level(x, params_.transition_width) != highest_level(x, -params_.transition_width);
+    return open_level(x, params_.transition_width) != open_level(x, -params_.transition_width);
   }
 
   // The mass and momentum accounts: the active mass (with conserve_mass) and momentum (with conserve_momentum) a pass
@@ -517,7 +546,8 @@ class AdaptiveRefinement {
       if (p.kind[a] != Kind::fluid) continue;
       const int k = level_of_particle(p, a);
       level_[a] = k;
-      const int inside = level_inside(p.position[a]);
+      const T dither = dither_offset(p.id[a]);
+      const int inside = open_level(p.position[a], dither);
       if (k > inside && k > level_near(p.position[a])) {
         removals_.push_back(a);
         leaving_[a] = 1;
@@ -526,7 +556,8 @@ class AdaptiveRefinement {
       std::uint8_t passive = k != inside ? 1 : 0;
       if (hysteresis > T(0) && initial_level < 0) {
         // within `hysteresis` of an edge where k is the active level on one side: keep the status
-        const int strict = highest_level(p.position[a], -hysteresis), loose = highest_level(p.position[a], hysteresis);
+        const int strict = open_level(p.position[a], dither - hysteresis),
+                  loose = open_level(p.position[a], dither + hysteresis);
         if (strict != loose && (k == strict || k == loose)) passive = p.passive[a];
       }
       if (passive != p.passive[a]) {
@@ -542,7 +573,8 @@ class AdaptiveRefinement {
     constexpr unsigned close_active = 1u, close_lower_passive = 2u;  // flags of close_
     close_.assign(n, 0);
     auto bunched_candidate = [&](std::size_t a) {
-      return p.kind[a] == Kind::fluid && !leaving_[a] && p.passive[a] && level_[a] > level_inside(p.position[a]);
+      return p.kind[a] == Kind::fluid && !leaving_[a] && p.passive[a] &&
+             level_[a] > open_level(p.position[a], dither_offset(p.id[a]));
     };
     auto close_distance = [&](std::size_t a) { return params_.bunched_fraction * spacing_of(level_[a]); };
     parallel_for(n, [&](std::size_t a) {
@@ -767,10 +799,10 @@ class AdaptiveRefinement {
   // finer box.
   bool distant(const Vector& x, int k) const {
     const T reach = T(2 * System::kernel_type::support) * params_.smoothing_ratio * spacing_of(k) +
-                    params_.status_hysteresis * params_.base_spacing;
+                    (params_.status_hysteresis + T(0.5) * params_.edge_dither) * params_.base_spacing;
     const int inside = level_inside(x);
-    if (k > inside) return highest_level(x, reach) < k;
-    if (k < inside) return highest_level(x, -reach) > k;
+    if (k > inside) return open_level(x, reach) < k;
+    if (k < inside) return open_level(x, -reach) > k;
     return false;
   }
 

@@ -88,6 +88,14 @@ struct PlantRefinement {
   /// AdaptiveRefinementParameters::distant_fit_interval, s: the passive particles far from the box edges fitted at
   /// this interval only (0: at every pass)
   T distant_fit_interval{T(0)};
+  /// AdaptiveRefinementParameters::edge_dither, base spacings, [0, 2]: each particle's own offset of the box edges
+  T edge_dither{T(0)};
+  /// Whether the box's bottom face (on the bed) and, with top = 0, its top face (above the crests) are wall faces
+  /// (RefinementBox::wall_faces): no fluid crosses them, so the statuses' dither and hysteresis, the accounts' band and
+  /// the distant particles are taken from the vertical faces only. false: the bed face counts as an edge, so the
+  /// accounts' band takes in the bottom transition width of the box (as in sessions 14-29,
+  /// docs/variable-resolution.md, session 30).
+  bool wall_faces{true};
 };
 
 /// The Posidonia flume: waves, resolution, plants and blade model (lengths in m).
@@ -199,7 +207,9 @@ struct PosidoniaFlume {
     const T x0 = std::round((x.front() - refinement.margin) / d) * d;
     const T x1 = std::round((x.back() + refinement.margin) / d) * d;
     const T z1 = refinement.top > T(0) ? std::round(refinement.top / d) * d : flume().wall_height();
-    return {{Vec<2, T>(x0, T(0)), Vec<2, T>(x1, z1), 1}};
+    RefinementBox<2, T> box{Vec<2, T>(x0, T(0)), Vec<2, T>(x1, z1), 1};
+    if (refinement.wall_faces) box.wall_faces = refinement.top > T(0) ? 0b0100u : 0b1100u;  // bed (and top)
+    return {box};
   }
   /// The adaptive refinement's parameters for refinement_boxes().
   AdaptiveRefinementParameters<T> adaptive_refinement_parameters() const {
@@ -219,6 +229,7 @@ struct PosidoniaFlume {
     a.lagrangian_statuses = refinement.lagrangian;
     a.boxes_follow_flow = refinement.follow_flow;
     a.distant_fit_interval = refinement.distant_fit_interval;
+    a.edge_dither = refinement.edge_dither;
     return a;
   }
   /// The real blade as a line of rod nodes (rod, drag), not a continuum of particle rows (scaled, equivalent).
