@@ -307,8 +307,13 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
                              "above the bed (m, second number)");
   // the active fluid's volume sum m / rho and mass, per unit width: a refinement box's status changes move water
   // between the active and the passive fluid, and its mass account hands the difference back at fixed density
-  io::CsvWriter volume_csv(dir / "fluid_volume.csv", {"t", "active_volume", "active_mass"},
-                           "active fluid particles: sum of m / rho (m^2 per m width) and of m (kg per m width)");
+  io::CsvWriter volume_csv(
+      dir / "fluid_volume.csv",
+      {"t", "active_volume", "active_mass", "status_mass_coarse", "status_nominal_coarse", "status_mass_fine",
+       "status_nominal_fine"},
+      "active fluid particles: sum of m / rho (m^2 per m width) and of m (kg per m width); with refinement, the active "
+      "mass the status changes of the coarse and the fine level brought in since the start, with the particles' "
+      "masses and at their nominal masses (kg per m width, before the accounts)");
   auto record_volume = [&](const System& s, double t) {
     const auto& p = s.particles();
     double volume = 0, mass = 0;
@@ -316,7 +321,12 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
       if (p.kind[i] != Kind::fluid || p.passive[i]) continue;
       volume += double(p.mass[i] / p.density[i]), mass += double(p.mass[i]);
     }
-    volume_csv.write_row({t, volume, mass});
+    std::array<double, 4> status{};
+    if constexpr (Refined) {
+      const auto& c = sim.template model<2>().total_counts();
+      status = {c.status_mass[0], c.status_nominal_mass[0], c.status_mass[1], c.status_nominal_mass[1]};
+    }
+    volume_csv.write_row({t, volume, mass, status[0], status[1], status[2], status[3]});
   };
   auto tip_position = [&](const System& s, std::size_t k) {
     if constexpr (Rods) return Vec<2, T>(sim.template model<1>().rod(k).tip_position());
@@ -912,9 +922,10 @@ int main(int argc, char** argv) try {
       "refinement: each particle sees the box edges moved by its own fixed offset, uniform over this width, base "
       "spacings, [0, 2] (a water column then changes status particle by particle)");
   s.refinement.wall_faces = cli.get_switch(
-      "wall-faces", true,
+      "wall-faces", false,
       "refinement: the box's bed face (and its top above the crests) counts as a wall, not an edge: no dither, "
-      "hysteresis or account band there (off: sessions 14-29's band along the bed): on | off");
+      "hysteresis or account band there (off: the accounts' band takes in the box's bottom transition width, as in "
+      "sessions 14-29): on | off");
   o.local_steps = cli.get_switch("local-steps", false,
                                  "refinement: local time stepping, the coarse fluid at twice the fine step: on | off");
   o.fine_step_margin = cli.get_number(

@@ -420,12 +420,12 @@ TEST_CASE("posidonia drag plants in a refined box: the box on the base lattice, 
   CHECK(boxes[0].lower[1] == 0.0);
   CHECK_THAT(boxes[0].upper[1], WithinRel(0.16, 1e-12));
   CHECK(boxes[0].level == 1);
-  CHECK(boxes[0].wall_faces == 0b0100u);  // the bed face; the top at 0.16 m is in the water, an open face
-  auto open_top = s;
-  open_top.refinement.top = 0;  // above the crests: a wall face too
-  CHECK(open_top.refinement_boxes()[0].wall_faces == 0b1100u);
-  open_top.refinement.wall_faces = false;
-  CHECK(open_top.refinement_boxes()[0].wall_faces == 0u);
+  CHECK(boxes[0].wall_faces == 0u);  // by default the bed face counts as an edge (sessions 14-29)
+  auto walled = s;
+  walled.refinement.wall_faces = true;
+  CHECK(walled.refinement_boxes()[0].wall_faces == 0b0100u);  // the bed face; the top at 0.16 m is in the water
+  walled.refinement.top = 0;                                   // above the crests: a wall face too
+  CHECK(walled.refinement_boxes()[0].wall_faces == 0b1100u);
 
   const auto g = s.flume();
   System system(scenes::wave_flume_domain(g), Tait<double>(1000, g.sound_speed()));

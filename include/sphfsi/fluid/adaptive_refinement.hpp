@@ -84,6 +84,7 @@
 #include <Eigen/LU>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -235,6 +236,13 @@ struct AdaptiveRefinementCounts {
   /// Largest pending mass of a relaxed mass account (mass_account_relaxation > 0) over the active mass, after the
   /// pass (0 without it).
   double pending_mass{0};
+  /// Active mass the status changes of each level k (index k, up to RefinementBox::max_level) brought in (+, the
+  /// particles that became active with their masses) and took out (-, those that became passive), before the
+  /// accounts; the totals sum over the passes. status_nominal_mass: the same with each particle counted at its
+  /// nominal mass rho0 (dp / 2^k)^Dim, so the difference of the two is the masses' deviation and the nominal sum the
+  /// count's (diagnostics of where the active mass moves, docs/variable-resolution.md, session 30).
+  std::array<double, 9> status_mass{};
+  std::array<double, 9> status_nominal_mass{};
 };
 
 /// Adaptive particle refinement with overlapping resolutions (see the header comment). A ParticleModel: it adds no
@@ -459,6 +467,10 @@ class AdaptiveRefinement {
     total_.mass_correction = std::max(total_.mass_correction, c.mass_correction);
     total_.momentum_correction = std::max(total_.momentum_correction, c.momentum_correction);
     total_.pending_mass = std::max(total_.pending_mass, c.pending_mass);
+    for (std::size_t k = 0; k < c.status_mass.size(); ++k) {
+      total_.status_mass[k] += c.status_mass[k];
+      total_.status_nominal_mass[k] += c.status_nominal_mass[k];
+    }
   }
 
   // Whether x lies within transition_width of a box edge (on either side): the band where statuses change.
@@ -562,6 +574,11 @@ class AdaptiveRefinement {
       }
       if (passive != p.passive[a]) {
         ++(passive ? counts.deactivated : counts.activated);
+        const double sign = passive ? -1.0 : 1.0;
+        const auto level = static_cast<std::size_t>(std::clamp(k, 0, Box::max_level));
+        counts.status_mass[level] += sign * static_cast<double>(p.mass[a]);
+        counts.status_nominal_mass[level] +=
+            sign * static_cast<double>(nominal_mass(k, system.eos().reference_density()));
       }
       p.passive[a] = passive;
     }

@@ -92,10 +92,10 @@ struct PlantRefinement {
   T edge_dither{T(0)};
   /// Whether the box's bottom face (on the bed) and, with top = 0, its top face (above the crests) are wall faces
   /// (RefinementBox::wall_faces): no fluid crosses them, so the statuses' dither and hysteresis, the accounts' band and
-  /// the distant particles are taken from the vertical faces only. false: the bed face counts as an edge, so the
-  /// accounts' band takes in the bottom transition width of the box (as in sessions 14-29,
-  /// docs/variable-resolution.md, session 30).
-  bool wall_faces{true};
+  /// the distant particles are taken from the vertical faces only. false (the default, as in sessions 14-29): the bed
+  /// face counts as an edge, so the accounts' band takes in the bottom transition width of the box. Measured, the
+  /// wall faces do not bring the refined run closer to the fine one (docs/variable-resolution.md, session 30).
+  bool wall_faces{false};
 };
 
 /// The Posidonia flume: waves, resolution, plants and blade model (lengths in m).
