@@ -364,8 +364,6 @@ class AdaptiveRefinement {
     return s;
   }
 
-  enum class Status : signed char { active, passive, removed };
-
   // Relative spread of smoothing lengths within one level (levels are a factor 2 apart): the neighbour loops that
   // look at one level only ask the search for that size band.
   static constexpr T level_tolerance = T(0.25);
