@@ -424,7 +424,7 @@ TEST_CASE("posidonia drag plants in a refined box: the box on the base lattice, 
   auto walled = s;
   walled.refinement.wall_faces = true;
   CHECK(walled.refinement_boxes()[0].wall_faces == 0b0100u);  // the bed face; the top at 0.16 m is in the water
-  walled.refinement.top = 0;                                   // above the crests: a wall face too
+  walled.refinement.top = 0;                                  // above the crests: a wall face too
   CHECK(walled.refinement_boxes()[0].wall_faces == 0b1100u);
 
   const auto g = s.flume();
