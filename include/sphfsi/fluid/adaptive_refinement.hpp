@@ -429,18 +429,11 @@ class AdaptiveRefinement {
     return level;
   }
 
+  // Highest level of the boxes containing x when their faces move out by margin (in if negative), wall faces kept.
   int highest_level(const Vector& x, T margin) const {
     int level = 0;
     for (const Box& b : boxes_)
       if (b.level > level && b.contains(x, margin)) level = b.level;
-    return level;
-  }
-
-  // Highest level of the boxes containing x when their open faces (not RefinementBox::wall_faces) move by margin.
-  int open_level(const Vector& x, T margin) const {
-    int level = 0;
-    for (const Box& b : boxes_)
-      if (b.level > level && b.contains_within_open_faces(x, margin)) level = b.level;
     return level;
   }
 
@@ -473,7 +466,7 @@ class AdaptiveRefinement {
 
   // Whether x lies within transition_width of a box edge (on either side): the band where statuses change.
   bool near_box_edge(const Vector& x) const {
-    return open_level(x, params_.transition_width) != open_level(x, -params_.transition_width);
+    return highest_level(x, params_.transition_width) != highest_level(x, -params_.transition_width);
   }
 
   // The mass and momentum accounts: the active mass (with conserve_mass) and momentum (with conserve_momentum) a pass
@@ -557,7 +550,7 @@ class AdaptiveRefinement {
       const int k = level_of_particle(p, a);
       level_[a] = k;
       const T dither = dither_offset(p.id[a]);
-      const int inside = open_level(p.position[a], dither);
+      const int inside = highest_level(p.position[a], dither);
       if (k > inside && k > level_near(p.position[a])) {
         removals_.push_back(a);
         leaving_[a] = 1;
@@ -566,8 +559,8 @@ class AdaptiveRefinement {
       std::uint8_t passive = k != inside ? 1 : 0;
       if (hysteresis > T(0) && initial_level < 0) {
         // within `hysteresis` of an edge where k is the active level on one side: keep the status
-        const int strict = open_level(p.position[a], dither - hysteresis),
-                  loose = open_level(p.position[a], dither + hysteresis);
+        const int strict = highest_level(p.position[a], dither - hysteresis),
+                  loose = highest_level(p.position[a], dither + hysteresis);
         if (strict != loose && (k == strict || k == loose)) passive = p.passive[a];
       }
       if (passive != p.passive[a]) {
@@ -589,7 +582,7 @@ class AdaptiveRefinement {
     close_.assign(n, 0);
     auto bunched_candidate = [&](std::size_t a) {
       return p.kind[a] == Kind::fluid && !leaving_[a] && p.passive[a] &&
-             level_[a] > open_level(p.position[a], dither_offset(p.id[a]));
+             level_[a] > highest_level(p.position[a], dither_offset(p.id[a]));
     };
     auto close_distance = [&](std::size_t a) { return params_.bunched_fraction * spacing_of(level_[a]); };
     parallel_for(n, [&](std::size_t a) {
@@ -816,8 +809,8 @@ class AdaptiveRefinement {
     const T reach = T(2 * System::kernel_type::support) * params_.smoothing_ratio * spacing_of(k) +
                     (params_.status_hysteresis + T(0.5) * params_.edge_dither) * params_.base_spacing;
     const int inside = level_inside(x);
-    if (k > inside) return open_level(x, reach) < k;
-    if (k < inside) return open_level(x, -reach) > k;
+    if (k > inside) return highest_level(x, reach) < k;
+    if (k < inside) return highest_level(x, -reach) > k;
     return false;
   }
 

@@ -53,21 +53,15 @@ struct RefinementBox {
   Vec<Dim, T> upper;  ///< m
   int level{1};       ///< refinement level, [1, max_level]
   /// Faces that lie on a wall, which no fluid crosses (a box standing on a bed): bit 2 d is the lower face along axis
-  /// d, bit 2 d + 1 the upper one. The adaptive refinement (fluid/adaptive_refinement.hpp) moves only the other, open
-  /// faces for its dithered and hysteretic statuses, and takes its account band and distant particles from them.
+  /// d, bit 2 d + 1 the upper one. contains() never moves them, so the adaptive refinement
+  /// (fluid/adaptive_refinement.hpp) dithers only the other, open faces, applies its hysteresis there and takes its
+  /// account band and distant particles from them alone.
   unsigned wall_faces{0};
 
   static constexpr int max_level = 8;
 
-  /// Whether x lies in the box grown by `margin` on every side (margin >= 0, m).
+  /// Whether x lies in the box grown by `margin` (m; negative: shrunk) on every side but its wall_faces.
   bool contains(const Vec<Dim, T>& x, T margin = T(0)) const {
-    for (int d = 0; d < Dim; ++d)
-      if (!(x[d] >= lower[d] - margin && x[d] <= upper[d] + margin)) return false;
-    return true;
-  }
-
-  /// Whether x lies in the box grown by `margin` (of either sign, m) on its open faces, the wall_faces kept.
-  bool contains_within_open_faces(const Vec<Dim, T>& x, T margin) const {
     for (int d = 0; d < Dim; ++d) {
       const T low = (wall_faces >> (2 * d)) & 1u ? T(0) : margin,
               high = (wall_faces >> (2 * d + 1)) & 1u ? T(0) : margin;
