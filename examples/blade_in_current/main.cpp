@@ -86,7 +86,13 @@ struct Options {
   // pressure the wake's suction pulls the fluid off the lee face (g = 0: no hydrostatic pressure, unlike the flume).
   T background_pressure = 0;
   T depth_lengths = 3;  // channel depth in blade lengths (blockage l / depth)
-  T average_from = 3;   // the drag is averaged once the blade has moved this many lengths after the ramp
+  // 3D: a strip of width b (a ribbon) in the middle of a channel of width W, so that the water can pass the blade's
+  // sides as round Luhar & Nepf's blades (b / l = 0.2), instead of the 2D full-width blade
+  bool three_d = false;
+  T blade_width = T(0.01);  // b, m (2D: the porous blade's added mass only)
+  T channel_width = 6;      // 3D: W / b, rounded to whole fluid spacings
+  int width_particles = 0;  // 3D: particles across the strip's width (0: b / (rod_spacing dp), at least 2)
+  T average_from = 3;       // the drag is averaged once the blade has moved this many lengths after the ramp
   std::vector<T> cauchy{0, 1, 3, 10, 30, 100, 300, 1000};  // 0: the rigid blade
   // The force-law sweep: rigid blades inclined by these angles from the vertical (degrees, leaning downstream).
   std::vector<T> inclinations;
@@ -153,36 +159,54 @@ T fluid_under_blade(const ParticleSet<2, T>& p, const Ids& ids, T dp) {
 }
 
 /// Runs one blade: flexible at the target Cauchy number, or rigid (target_ca = 0). `inclination`: the blade's rest
-/// angle from the vertical, leaning downstream (rad; the rigid blades of the force-law sweep).
-template <class Coupling>
+/// angle from the vertical, leaning downstream (rad; the rigid blades of the force-law sweep, 2D only). Dim = 3: the
+/// blade is a strip of width b (a ribbon, solid/elastic_rod.hpp) in the middle of a channel of width W; forces are
+/// then per blade (N), in 2D per unit width (N/m).
+template <int Dim, class Coupling>
 CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
-  using Blade = CoupledBody<Coupling, Rod>;
-  using Solver = Simulation<System, SymplecticVerlet, Blade>;
+  using SystemD = ParticleSystem<Dim, T, WendlandC2<Dim>, Tait<T>>;
+  using RodD = ElasticRod<SystemD>;
+  using VD = Vec<Dim, T>;
+  using Blade = CoupledBody<Coupling, RodD>;
+  using Solver = Simulation<SystemD, SymplecticVerlet, Blade>;
   constexpr bool porous = std::is_same_v<Coupling, BladeDrag<T>>;
   const T l = o.length, dp = l / o.particles_along, depth = o.depth_lengths * l, U = o.speed, rho = 1000;
   const T x0 = 2 * l, ramp = T(0.25), tow = o.tow_lengths * l;
   const T tank = x0 + U * ramp / 2 + tow + 3 * l;
   const T c0 = o.sound_speed * U;  // the flow around the blade's tip reaches about 2 U: c0 >= 10 x that
   const Resolution<T> res{dp, T(1.3)};
-  System system(Domain<2, T>(V(-4 * dp, -4 * dp), V(tank + 4 * dp, depth + 4 * dp)), Tait<T>(rho, c0));
-  add_fluid_block(system, V(0, 0), V(tank, depth), res, depth, T(0));
+  // (x, z) in the channel's plane; in 3D the channel spans y in [-W/2, W/2] (a whole number of spacings)
+  const T half_width = T(0.5) * dp * std::max(T(1), std::round(o.channel_width * o.blade_width / dp));
+  const auto at = [&](T x, T y, T z) {
+    if constexpr (Dim == 2) return VD(x, z);
+    else return VD(x, y, z);
+  };
+  SystemD system(Domain<Dim, T>(at(-4 * dp, -half_width - 4 * dp, -4 * dp),
+                                at(tank + 4 * dp, half_width + 4 * dp, depth + 4 * dp)),
+                 Tait<T>(rho, c0));
+  add_fluid_block(system, at(0, -half_width, 0), at(tank, half_width, depth), res, depth, T(0));
   // The blade leans downstream of the towing (towards -x) by `inclination`. Upright, it lies on a lattice line with
   // the fluid columns dp/2 on either side; inclined, the fluid within dp/2 of it is taken out.
   const V direction(-std::sin(inclination), std::cos(inclination));
   const V mount(x0, target_ca > 0 ? T(0) : std::round(o.mount_height * l / dp) * dp);  // the blade's base
-  if (inclination != 0) {
-    auto& p = system.particles();
-    for (std::size_t k = p.size(); k-- > 0;) {
-      const V r = p.position[k] - mount;
-      const T along = std::clamp(r.dot(direction), T(0), l);
-      if ((r - along * direction).norm() < dp / 2) p.remove(k);
+  if constexpr (Dim == 2) {
+    if (inclination != 0) {
+      auto& p = system.particles();
+      for (std::size_t k = p.size(); k-- > 0;) {
+        const V r = p.position[k] - mount;
+        const T along = std::clamp(r.dot(direction), T(0), l);
+        if ((r - along * direction).norm() < dp / 2) p.remove(k);
+      }
     }
   }
-  add_box_walls(system, V(0, 0), V(tank, depth), res, WallModel::dynamic);
-  for_each_lattice_point<2, T>(V(-3 * dp, depth), V(tank + 3 * dp, depth + 3 * dp), dp, [&](const V& x) {
-    system.particles().add(Kind::wall, x, V::Zero(), rho, rho * dp * dp, res.h(), 0);  // the lid
-  });
-  // The blade on a lattice line (fluid columns at dp/2 on either side), nodes every rod_spacing dp (dp/2).
+  add_box_walls(system, at(0, -half_width, 0), at(tank, half_width, depth), res, WallModel::dynamic);
+  for_each_lattice_point<Dim, T>(at(-3 * dp, -half_width - 3 * dp, depth),
+                                 at(tank + 3 * dp, half_width + 3 * dp, depth + 3 * dp), dp, [&](const VD& x) {
+                                   system.particles().add(Kind::wall, x, VD::Zero(), rho, rho * std::pow(dp, T(Dim)),
+                                                          res.h(), 0);  // the lid
+                                 });
+  // The blade on a lattice line (fluid columns at dp/2 on either side), nodes every rod_spacing dp (dp/2); in 3D
+  // each node a row across the strip's width at about the same spacing.
   const int nodes = static_cast<int>(std::lround(o.particles_along / o.rod_spacing)) + 1;
   ElasticMaterial<T> material;
   material.density = o.density;
@@ -190,9 +214,16 @@ CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
   const T second_moment = o.thickness * o.thickness * o.thickness / 12;  // per unit width, m^3
   material.youngs_modulus =
       target_ca > 0 ? rho * o.nominal_drag * U * U * l * l * l / (2 * target_ca * second_moment) : T(1e9);
-  const RodSection<T> section{.thickness = o.thickness, .width = T(0.01)};
-  add_elastic_rod(system, mount, direction, l, nodes, material, section, res.h(), 1);
-  typename Rod::Parameters params;
+  const RodSection<T> section{.thickness = o.thickness, .width = o.blade_width};
+  if constexpr (Dim == 2) {
+    add_elastic_rod(system, mount, direction, l, nodes, material, section, res.h(), 1);
+  } else {
+    const int rows = o.width_particles > 0
+                         ? o.width_particles
+                         : std::max(2, static_cast<int>(std::lround(o.blade_width / (o.rod_spacing * dp))));
+    add_elastic_ribbon(system, mount, direction, l, nodes, rows, T(0), material, section, res.h(), 1);
+  }
+  typename RodD::Parameters params;
   params.section = section;
   params.gravity = V::Zero();
   params.damping = o.rod_damping;
@@ -201,7 +232,7 @@ CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
   // moving normal to itself, rho pi b / 4 per unit length and width. The repulsive blade pushes the fluid and gets
   // its added mass from it.
   if constexpr (porous) params.added_mass_per_area = plate_added_mass_per_area(rho, section.width);
-  Rod rod(system, 1, material, params);
+  RodD rod(system, 1, material, params);
   // A resolved blade folding over rests contact_gap fluid spacings above the bed, so the fluid trapped under it keeps
   // room: at dp / 2 the first fluid row was crushed between the bed and the blade (a blow-up at Ca = 390); at dp,
   // once the guard stops that water escaping through the blade, it is squeezed through the bed instead (Ca = 142,
@@ -209,7 +240,7 @@ CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
   // lowest g upright).
   rod.set_contact_plane(V(0, 0), V(0, 1), porous ? T(0) : o.contact_gap * dp);
   if (target_ca > 0) rod.clamp_base();
-  else rod.clamp_where([](const V&) { return true; });  // the rigid reference blade
+  else rod.clamp_where([](const VD&) { return true; });  // the rigid reference blade
   // Towing: velocity U (1 - cos(pi t / ramp)) / 2 during the ramp, U after it.
   const T pi = std::numbers::pi_v<T>;
   rod.set_clamp_motion(
@@ -217,10 +248,11 @@ CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
         return V(t < ramp ? U * (t / 2 - ramp / (2 * pi) * std::sin(pi * t / ramp)) : U * (t - ramp / 2), 0);
       },
       [=](T t) { return V(t < ramp ? U * (1 - std::cos(pi * t / ramp)) / 2 : U, 0); });
-  FluidParameters<2, T> fluid;
-  fluid.gravity = V::Zero();
+  FluidParameters<Dim, T> fluid;
+  fluid.gravity = VD::Zero();
   fluid.artificial_viscosity = o.artificial_viscosity;
-  fluid.thin_structure_visibility = o.visibility && !porous;  // the fluid passes a porous blade
+  // the fluid passes a porous blade; the visibility criterion and the guard are planar (2D blades only)
+  fluid.thin_structure_visibility = Dim == 2 && o.visibility && !porous;
   fluid.thin_structure_guard = o.guard;
   fluid.background_pressure = o.background_pressure * rho * U * U;
   Coupling coupling;
@@ -245,10 +277,13 @@ CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
   io::CsvWriter csv(o.output / fmt::format("case_{}.csv", label),
                     {"t", "drag", "lift", "tip_dx", "tip_dy", "fluid_under"});
   const T t_end = o.end_time > 0 ? o.end_time : ramp + tow / U, t_avg = ramp + o.average_from * l / U;
-  const auto& ids = sim.template model<0>().solid().particle_ids();
+  const RodD& blade = sim.template model<0>().solid();
+  const std::size_t node_count = blade.node_count(), per_node = blade.particles_per_node();
+  const auto& ids = blade.particle_ids();
   std::vector<T> samples, lift_samples;
-  // node positions relative to the base and the couplings' force on each node, summed over the averaging window
-  std::vector<V> mean_shape(ids.size(), V::Zero()), mean_load(ids.size(), V::Zero());
+  // node positions relative to the base and the couplings' force on each node (its row in 3D), summed over the
+  // averaging window
+  std::vector<V> mean_shape(node_count, V::Zero()), mean_load(node_count, V::Zero());
   T tip_x = 0, tip_y = 0, tip_y_squared = 0, under_sum = 0;
   std::size_t tip_n = 0;
   io::ProgressReporter progress(t_end);
@@ -256,32 +291,35 @@ CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
   T next_sample = 0;
   // Fluid particles that crossed the (impermeable) blade, counted every step, and those the guard put back.
   struct OneBlade {
-    const Rod& only;
+    const RodD& only;
     std::size_t size() const noexcept { return 1; }
-    const Rod& rod(std::size_t) const noexcept { return only; }
+    const RodD& rod(std::size_t) const noexcept { return only; }
   };
-  scenes::BladeCrossingCounter<System> crossings(T(1.5) * dp);
+  scenes::BladeCrossingCounter<SystemD> crossings(T(1.5) * dp);
   sim.run(t_end, [&](Solver& s) {
     progress(s);
     if constexpr (!porous) crossings.update(s.system(), OneBlade{s.template model<0>().solid()});
     if (s.time() < next_sample) return;
     next_sample += T(0.005);
     const auto& p = s.system().particles();
-    const V force = s.template model<0>().solid().coupling_force(p);
-    const T drag = -force[0];
-    const V base = p.position[p.slot_of_id(ids.front())], tip = p.position[p.slot_of_id(ids.back())];
-    const T under = porous ? T(0) : fluid_under_blade(p, ids, dp) / (l * l);
-    csv.write_row({s.time(), drag, force[1], tip[0] - base[0], tip[1] - base[1], under});
+    const VD force = s.template model<0>().solid().coupling_force(p);
+    const T drag = -force[0], lift = force[Dim - 1];
+    const auto& x = s.template model<0>().solid().positions();
+    const V base = x.front(), tip = x.back();
+    T under = std::numeric_limits<T>::quiet_NaN();  // 2D: the fluid a folded full-width blade seals off
+    if constexpr (Dim == 2) under = porous ? T(0) : fluid_under_blade(p, ids, dp) / (l * l);
+    csv.write_row({s.time(), drag, lift, tip[0] - base[0], tip[1] - base[1], under});
     if (s.time() >= t_avg) {
       samples.push_back(drag);
-      lift_samples.push_back(force[1]);
+      lift_samples.push_back(lift);
       tip_x += tip[0] - base[0];
       tip_y += tip[1] - base[1];
       tip_y_squared += (tip[1] - base[1]) * (tip[1] - base[1]);
-      for (std::size_t k = 0; k < ids.size(); ++k) {
-        const std::size_t slot = p.slot_of_id(ids[k]);
-        mean_shape[k] += p.position[slot] - base;
-        mean_load[k] += p.mass[slot] * p.acceleration[slot];
+      for (std::size_t k = 0; k < node_count; ++k) mean_shape[k] += x[k] - base;
+      for (std::size_t i = 0; i < ids.size(); ++i) {
+        const std::size_t slot = p.slot_of_id(ids[i]);
+        const VD f = p.mass[slot] * p.acceleration[slot];
+        mean_load[i / per_node] += V(f[0], f[Dim - 1]);
       }
       under_sum += under;
       ++tip_n;
@@ -297,7 +335,7 @@ CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
   const T n = T(tip_n), height = tip_y / n;
   if (tip_n > 0) {  // the blade's mean posture over the averaging window, base to tip
     io::CsvWriter shape(o.output / fmt::format("shape_{}.csv", label), {"node", "dx", "dy", "force_x", "force_y"});
-    for (std::size_t k = 0; k < ids.size(); ++k)
+    for (std::size_t k = 0; k < node_count; ++k)
       shape.write_row({T(k), mean_shape[k][0] / n, mean_shape[k][1] / n, mean_load[k][0] / n, mean_load[k][1] / n});
   }
   return {target_ca,     material.youngs_modulus,
@@ -334,7 +372,7 @@ int run_force_law_sweep(const Options& o) {
   for (const T degrees : o.inclinations) {
     fmt::print("--- rigid blade inclined by {:g} degrees\n", degrees);
     const T theta = degrees * pi / 180;
-    const CaseResult r = run_case<RepulsiveForce<T>>(o, 0, theta);
+    const CaseResult r = run_case<2, RepulsiveForce<T>>(o, 0, theta);
     // Decomposed on the blade: n = (-cos, -sin) is the downstream face's normal (the blade leans towards -x, the
     // water moves along -x relative to it), t = (-sin, cos) its tangent. drag = -F_x, lift = F_z.
     const T normal = r.drag * std::cos(theta) - r.lift * std::sin(theta);
@@ -429,6 +467,13 @@ int main(int argc, char** argv) try {
   o.force_law = cli.get("force-law", "",
                         "inclined.csv of a force-law sweep: the static reconfiguration under that measured local law "
                         "is added to the Cauchy sweep's summary (column model_2d)");
+  o.three_d = cli.get_switch("three-d", false,
+                             "on: a 3D channel with a strip of width --blade-width (a ribbon: the water passes its "
+                             "sides) | off: the 2D full-width blade");
+  o.blade_width = cli.get_number("blade-width", o.blade_width, "blade width b, m (2D: the drag blade's added mass)");
+  o.channel_width = cli.get_number("channel-width", o.channel_width, "--three-d: channel width W / b, [2, 50]");
+  o.width_particles = static_cast<int>(cli.get_number(
+      "width-particles", 0, "--three-d: particles across the strip's width (0: b / (rod spacing), at least 2)"));
   o.output = cli.get("output", o.output.string(), "output folder");
   if (!cli.finish()) return 0;
   require_positive("--speed (m/s)", o.speed);
@@ -442,6 +487,11 @@ int main(int argc, char** argv) try {
   require_in_range("--rod-damping (c_d, 1/s)", o.rod_damping, T(0), T(1000));
   require_in_range("--depth (blade lengths)", o.depth_lengths, T(1.5), T(20));
   require_in_range("--average-from (blade lengths)", o.average_from, T(0), o.tow_lengths - T(1));
+  require_positive("--blade-width (m)", o.blade_width);
+  require_in_range("--channel-width (W / b)", o.channel_width, T(2), T(50));
+  require_in_range("--width-particles", o.width_particles, 0, 64);
+  if (o.three_d && o.coupling != "repulsive")
+    throw InputError("--three-d: the strip is coupled by --coupling repulsive only (the drag blade is 2D)");
   const auto parse_list = [](const std::string& text) {
     std::vector<T> values;
     std::stringstream ss(text);
@@ -451,7 +501,10 @@ int main(int argc, char** argv) try {
   o.cauchy = parse_list(list);
   o.inclinations = parse_list(inclination_list);
   std::filesystem::create_directories(o.output);
-  if (!o.inclinations.empty()) return run_force_law_sweep(o);
+  if (!o.inclinations.empty()) {
+    if (o.three_d) throw InputError("--inclinations: the force-law sweep is 2D (leave out --three-d)");
+    return run_force_law_sweep(o);
+  }
   if (o.cauchy.empty() || (o.end_time == 0 && o.cauchy.front() != 0))
     throw InputError("--cauchy must start with 0 (the rigid blade that every l_e / l is measured against)");
   // The measured local law, read before the runs so that a bad file stops at once.
@@ -462,7 +515,9 @@ int main(int argc, char** argv) try {
   for (const T ca : o.cauchy) {
     fmt::print("--- {}\n", ca > 0 ? fmt::format("Ca = {:g}", ca) : std::string("rigid blade"));
     try {
-      results.push_back(o.coupling == "drag" ? run_case<BladeDrag<T>>(o, ca) : run_case<RepulsiveForce<T>>(o, ca));
+      results.push_back(o.three_d              ? run_case<3, RepulsiveForce<T>>(o, ca)
+                        : o.coupling == "drag" ? run_case<2, BladeDrag<T>>(o, ca)
+                                               : run_case<2, RepulsiveForce<T>>(o, ca));
     } catch (const BlowUpError& e) {  // a failed case is a result: reported in the table, the others still run
       if (ca == 0) throw;             // without the rigid reference there is nothing to compare with
       fmt::print(stderr, "Ca = {:g}: run stopped: {}\n", ca, e.what());
@@ -479,9 +534,12 @@ int main(int argc, char** argv) try {
     return 0;
   }
   const T rigid = results.front().drag, rho = 1000;
-  const T drag_coefficient = rigid / (T(0.5) * rho * o.speed * o.speed * o.length);
-  fmt::print("rigid blade: F = {:.4g} +- {:.2g} N/m, C_D = {:.3f} (blockage l / depth = {:.3g} included)\n", rigid,
-             results.front().drag_error, drag_coefficient, 1 / o.depth_lengths);
+  // in 3D the drag is the strip's (N), in 2D per unit width (N/m)
+  const T frontal = o.three_d ? o.length * o.blade_width : o.length;
+  const T drag_coefficient = rigid / (T(0.5) * rho * o.speed * o.speed * frontal);
+  fmt::print("rigid blade: F = {:.4g} +- {:.2g} {}, C_D = {:.3f} (blockage {:.3g} included)\n", rigid,
+             results.front().drag_error, o.three_d ? "N" : "N/m", drag_coefficient,
+             o.three_d ? 1 / (o.depth_lengths * o.channel_width) : 1 / o.depth_lengths);
   io::CsvWriter summary(
       o.output / "summary.csv",
       {"target_ca", "ca", "youngs_modulus", "drag", "drag_error", "effective_length", "effective_length_error", "model",

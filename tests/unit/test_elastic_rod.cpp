@@ -535,3 +535,82 @@ TEST_CASE("reconfiguration: the shooting solution equals the discrete rod relaxe
     CHECK(std::abs(rod.tip_position()[1] / L - shot.tip_z) < 1e-3);
   }
 }
+
+namespace {
+using System3 = sphfsi::ParticleSystem<3, double, sphfsi::WendlandC2<3>, sphfsi::LinearEos<double>>;
+using Ribbon = sphfsi::ElasticRod<System3>;
+using V3 = sphfsi::Vec<3, double>;
+static_assert(sphfsi::SolidModel<Ribbon, System3>);
+}  // namespace
+
+TEST_CASE("elastic rod: a 3D ribbon bends as the planar rod under the same total load", "[rod][ribbon]") {
+  // The same blade (10 edges) as a 2D rod and as a 3D ribbon with rows of 3 across its width b. A tip load P is put
+  // on one particle of the ribbon's tip row only: the node sees the row's total. Both relax dynamically to rest.
+  const int edges = 10, rows = 3;
+  const double alpha = 3, P = alpha * EI / (L * L), dt_outer = 1e-4;
+  System flat = make_blade(edges);
+  Rod rod(flat, 0, blade, weightless(2 * omega1));
+  rod.clamp_base();
+  System3 space(sphfsi::Domain<3, double>(V3(-1, -1, -1), V3(1, 1, 1)), sphfsi::LinearEos<double>(1000, 10));
+  const auto ids =
+      sphfsi::add_elastic_ribbon(space, V(0, 0), V(1, 0), L, edges + 1, rows, 0.2, blade, section, L / edges, 0);
+  REQUIRE(ids.size() == std::size_t((edges + 1) * rows));
+  Ribbon ribbon(space, 0, blade, weightless(2 * omega1));
+  CHECK(ribbon.node_count() == std::size_t(edges + 1));
+  CHECK(ribbon.particles_per_node() == std::size_t(rows));
+  CHECK(ribbon.clamp_where([](const V3& x) { return x.x() < 1e-12; }) == 1);  // the base row
+  const auto [y_lo, y_hi] = ribbon.lateral_extent();
+  CHECK(y_lo == Approx(0.2 - b / 2).margin(1e-15));
+  CHECK(y_hi == Approx(0.2 + b / 2).margin(1e-15));
+  // each particle carries b / rows of the width: the rows' masses sum to the rod's node masses
+  double mass = 0;
+  for (auto id : ids) mass += space.particles().mass[space.particles().slot_of_id(id)];
+  CHECK(mass == Approx(blade.density * section.area() * L).epsilon(1e-12));
+  auto& p3 = space.particles();
+  const std::size_t loaded = p3.slot_of_id(ids.back());
+  double t = 0;
+  for (int step = 0; step < 3000; ++step) {
+    flat.particles().acceleration[flat.particles().slot_of_id(rod.particle_ids().back())] =
+        V(0, -P / rod.node_masses().back());
+    for (auto id : ids) p3.acceleration[p3.slot_of_id(id)].setZero();
+    p3.acceleration[loaded] = V3(0, 0, -P / p3.mass[loaded]);
+    rod.advance(flat, t, dt_outer);
+    ribbon.advance(space, t, dt_outer);
+    t += dt_outer;
+  }
+  const double tip_dy = -rod.tip_position().y() / L;
+  REQUIRE(tip_dy > 0.3);  // a large deflection: the comparison is not a small-load limit
+  for (std::size_t k = 0; k < ribbon.node_count(); ++k) {
+    CHECK((ribbon.positions()[k] - rod.positions()[k]).norm() < 1e-12 * L);
+    CHECK((ribbon.velocities()[k] - rod.velocities()[k]).norm() < 1e-9 * L * omega1);
+  }
+  // every particle of a row sits at its node's (x, z), at its own y, moves in the x-z plane, and carries the normal
+  std::array<int, 1> checked{0};
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    const std::size_t s = p3.slot_of_id(ids[i]), k = i / rows;
+    const V3 x = p3.position[s];
+    CHECK(x.x() == ribbon.positions()[k].x());
+    CHECK(x.z() == ribbon.positions()[k].y());
+    CHECK(x.y() == Approx(0.2 + (double(i % rows) - 1) * b / rows).epsilon(1e-14));
+    CHECK(p3.velocity[s].y() == 0);
+    const V n2 = flat.particles().normal[flat.particles().slot_of_id(rod.particle_ids()[k])];
+    CHECK((p3.normal[s] - V3(n2.x(), 0, n2.y())).norm() < 1e-9);
+    ++checked[0];
+  }
+  CHECK(checked[0] == (edges + 1) * rows);
+  // the total coupling force is the sum over the particles (here the tip load)
+  CHECK((ribbon.coupling_force(p3) - V3(0, 0, -P)).norm() < 1e-12 * P);
+}
+
+TEST_CASE("elastic rod: a 3D ribbon with unequal rows is rejected", "[rod][ribbon]") {
+  System3 space(sphfsi::Domain<3, double>(V3(-1, -1, -1), V3(1, 1, 1)), sphfsi::LinearEos<double>(1000, 10));
+  sphfsi::add_elastic_ribbon(space, V(0, 0), V(0, 1), L, 6, 2, 0.0, blade, section, L / 5, 0);
+  auto& p = space.particles();
+  p.position[p.slot_of_id(5)].x() += 1e-3;  // the second particle of node 2's row leaves the row
+  CHECK_THROWS_WITH(Ribbon(space, 0, blade, weightless()), Catch::Contains("ElasticRod: particle id 5"));
+  p.remove(p.slot_of_id(5));  // a row one particle short
+  CHECK_THROWS_WITH(Ribbon(space, 0, blade, weightless()),
+                    Catch::Contains("has 11 particles, not a whole number of rows of 2"));
+  CHECK_THROWS_WITH(sphfsi::add_elastic_ribbon(space, V(0, 0), V(0, 1), L, 6, 0, 0.0, blade, section, L / 5, 1),
+                    Catch::Contains("width_particles"));
+}

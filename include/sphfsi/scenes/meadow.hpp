@@ -398,12 +398,15 @@ RodBlades<System, BladeDrag<typename System::scalar_type>> add_drag_blades(
 /// Counts fluid particles that crossed a blade between two calls: a particle within `reach` of a blade's bounding
 /// box at both calls whose path (its two positions) met one of the blade's edges (its nodes' two positions), all
 /// taken to move linearly in between (ThinStructureGuard::crossing, the guard's own swept test). Water going round
-/// the tip never meets an edge. Call it every step: between calls far apart the motion is not linear.
+/// the tip never meets an edge. Call it every step: between calls far apart the motion is not linear. In 3D the
+/// blades are ribbons (solid/elastic_rod.hpp): the test runs in their x-z plane for the fluid particles that lie within
+/// the strip's width at both calls (water going round the strip's side edges is not counted).
 template <class System>
 class BladeCrossingCounter {
  public:
   using T = typename System::scalar_type;
   using Vector = Vec<2, T>;
+  static constexpr int Dim = System::dimension;
 
   explicit BladeCrossingCounter(T reach) : reach_(reach) { require_positive("BladeCrossingCounter reach (m)", reach); }
 
@@ -420,10 +423,15 @@ class BladeCrossingCounter {
       Vector lo = x[0], hi = x[0];
       for (const auto& v : x) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
       lo.array() -= reach_, hi.array() += reach_;
+      std::pair<T, T> strip{T(0), T(0)};
+      if constexpr (Dim == 3) strip = blades.rod(b).lateral_extent();
       const auto& before = nodes_[b];
       for (std::size_t f = 0; f < p.size(); ++f) {
         if (p.kind[f] != Kind::fluid) continue;
-        const Vector& y = p.position[f];
+        if constexpr (Dim == 3) {
+          if (p.position[f][1] < strip.first || p.position[f][1] > strip.second) continue;
+        }
+        const Vector y = in_plane(p.position[f]);
         if (y[0] < lo[0] || y[0] > hi[0] || y[1] < lo[1] || y[1] > hi[1]) continue;
         now.emplace(p.id[f], y);
         const auto it = near_[b].find(p.id[f]);
@@ -443,6 +451,10 @@ class BladeCrossingCounter {
   std::size_t total() const noexcept { return total_; }
 
  private:
+  static Vector in_plane(const Vec<Dim, T>& x) {
+    if constexpr (Dim == 2) return x;
+    else return Vector(x[0], x[2]);
+  }
   T reach_;
   std::vector<std::vector<Vector>> nodes_;                       // per blade: node positions at the last call
   std::vector<std::unordered_map<std::uint32_t, Vector>> near_;  // per blade: fluid near it at the last call, by id

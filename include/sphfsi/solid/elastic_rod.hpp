@@ -39,6 +39,14 @@
 // width b), so the force per unit mass that a 2D coupling writes applies unchanged to the real blade. After every
 // step each node carries p.normal, the unit normal of the blade (left of the base-to-tip tangent); the other face
 // has -p.normal.
+//
+// In 3D the same rod is a ribbon (add_elastic_ribbon): a strip of width b along the lateral axis y whose bending stays
+// in the x-z plane (the plane of the current and the vertical; by symmetry a strip towed or held normal to a current
+// bends only in that plane; Luhar & Nepf 2011 model it so). Each node is a row of w particles across the width at the
+// node's (x, z), each with mass rho t D_i b / w; the rod's node sees the mass-weighted mean of their accelerations
+// (the total fluid force on the row over the row's mass), and every particle of the row moves with the node.
+// Forces along y on the row are taken by the strip's in-plane stiffness (its bending about the thin axis is b^2 / t^2
+// times stiffer) and passed to its clamp.
 #pragma once
 
 #include <sphfsi/core/error.hpp>
@@ -140,30 +148,84 @@ std::vector<std::uint32_t> add_elastic_rod(System& system, const Vec<2, typename
   return ids;
 }
 
-/// Planar discrete elastic rod owning the solid particles of one body (a ParticleModel and a SolidModel).
+/// Adds a straight ribbon to a 3D system (see the header comment): `node_count` equally spaced nodes from `base`
+/// along `direction` over `length`, both in the x-z plane ((x, z) pairs), each node a row of `width_particles`
+/// particles across the section's width b, centred on y = `lateral_centre` at y = centre + (j + 1/2 - w/2) b / w
+/// (each stands for b / w of the width), base first (increasing ids), with masses rho t D_i b / w and smoothing length
+/// `smoothing_length`. Returns their ids. The ElasticRod built on this body is the ribbon.
+template <class System>
+std::vector<std::uint32_t> add_elastic_ribbon(System& system, const Vec<2, typename System::scalar_type>& base,
+                                              const Vec<2, typename System::scalar_type>& direction,
+                                              typename System::scalar_type length, int node_count, int width_particles,
+                                              typename System::scalar_type lateral_centre,
+                                              const ElasticMaterial<typename System::scalar_type>& material,
+                                              const RodSection<typename System::scalar_type>& section,
+                                              typename System::scalar_type smoothing_length, std::int32_t body) {
+  using T = typename System::scalar_type;
+  static_assert(System::dimension == 3, "add_elastic_ribbon: a ribbon needs a 3D system (add_elastic_rod in 2D)");
+  material.validate();
+  section.validate();
+  require_positive("add_elastic_ribbon: length (m)", length);
+  require_in_range("add_elastic_ribbon: node_count", node_count, 3, 1 << 24);
+  require_in_range("add_elastic_ribbon: width_particles", width_particles, 1, 1 << 12);
+  require_positive("add_elastic_ribbon: smoothing_length (m)", smoothing_length);
+  require_positive("add_elastic_ribbon: |direction|", direction.norm());
+  require_finite("add_elastic_ribbon: lateral_centre (m)", lateral_centre);
+  for (int d = 0; d < 2; ++d) require_finite("add_elastic_ribbon: base (m)", base[d]);
+  const Vec<2, T> e = direction.normalized();
+  const T ds = length / T(node_count - 1), db = section.width / T(width_particles);
+  std::vector<std::uint32_t> ids;
+  auto& p = system.particles();
+  for (int i = 0; i < node_count; ++i) {
+    const T voronoi = (i == 0 || i == node_count - 1) ? T(0.5) * ds : ds;
+    const Vec<2, T> x = base + (T(i) * ds) * e;
+    for (int j = 0; j < width_particles; ++j) {
+      const T y = lateral_centre + (T(j) + T(0.5) - T(0.5) * T(width_particles)) * db;
+      const std::size_t slot = p.add(Kind::solid, Vec<3, T>(x[0], y, x[1]), Vec<3, T>::Zero(), material.density,
+                                     material.density * section.thickness * voronoi * db, smoothing_length, body);
+      ids.push_back(p.id[slot]);
+    }
+  }
+  return ids;
+}
+
+/// Planar discrete elastic rod owning the solid particles of one body (a ParticleModel and a SolidModel); in a 3D
+/// system a ribbon bending in the x-z plane (see the header comment).
 template <class System>
 class ElasticRod {
  public:
-  static_assert(System::dimension == 2, "ElasticRod is a planar rod: use a 2D ParticleSystem");
-  static constexpr int Dim = 2;
+  static constexpr int Dim = System::dimension;
+  static_assert(Dim == 2 || Dim == 3, "ElasticRod: a 2D rod or a 3D ribbon");
   /// A line of nodes with no interior: couplings take the normal each node publishes and push on both faces
   /// (coupling/repulsive_force.hpp) instead of finding a surface by the colour gradient.
   static constexpr bool thin_structure = true;
   using T = typename System::scalar_type;
-  using Vector = Vec<2, T>;
-  using Matrix = Mat<2, T>;
+  using Vector = Vec<2, T>;  ///< in the rod's plane: (x, vertical)
+  using SpaceVector = Vec<Dim, T>;
+  using Matrix = Mat<Dim, T>;
   using Parameters = ElasticRodParameters<T>;
 
   /// Takes the solid particles of `body` as nodes, base to tip in increasing id; their current positions are
-  /// the rest shape (straight or curved). Throws InputError for invalid parameters, fewer than 3 nodes or
-  /// coincident nodes.
+  /// the rest shape (straight or curved). In 3D consecutive ids at the same (x, z) are one node's row across the
+  /// width (add_elastic_ribbon). Throws InputError for invalid parameters, fewer than 3 nodes, coincident nodes or
+  /// rows of unequal size.
   ElasticRod(const System& system, std::int32_t body, const ElasticMaterial<T>& material, const Parameters& params = {})
       : material_((material.validate(), material)), params_((params.validate(), params)), body_(body) {
     const auto& p = system.particles();
     for (std::size_t i = 0; i < p.size(); ++i)
       if (p.kind[i] == Kind::solid && p.body[i] == body) ids_.push_back(p.id[i]);
     std::sort(ids_.begin(), ids_.end());
-    const std::size_t n = ids_.size();
+    if constexpr (Dim == 3) {  // the row of the first node: the leading particles at its (x, z)
+      while (per_node_ < ids_.size() &&
+             in_plane(p.position[p.slot_of_id(ids_[per_node_])]) == in_plane(p.position[p.slot_of_id(ids_[0])]))
+        ++per_node_;
+    }
+    if (ids_.size() % per_node_ != 0)
+      throw InputError(
+          fmt::format("ElasticRod: body {} has {} particles, not a whole number of rows of {} (valid: "
+                      "add the ribbon with add_elastic_ribbon)",
+                      body, ids_.size(), per_node_));
+    const std::size_t n = ids_.size() / per_node_;
     if (n < 3)
       throw InputError(
           fmt::format("ElasticRod: body {} has {} nodes: valid range is [3, inf) (add the nodes with "
@@ -172,11 +234,25 @@ class ElasticRod {
     local_of_id_.assign(p.id_capacity(), -1);  // indexed by id: ids of removed particles stay unused
     x_.resize(n);
     v_.resize(n);
-    for (std::size_t k = 0; k < n; ++k) {
-      local_of_id_[ids_[k]] = static_cast<std::int64_t>(k);
-      const std::size_t s = p.slot_of_id(ids_[k]);
-      x_[k] = p.position[s];
-      v_[k] = p.velocity[s];
+    lateral_.resize(ids_.size());
+    for (std::size_t i = 0; i < ids_.size(); ++i) {
+      const std::size_t k = i / per_node_, s = p.slot_of_id(ids_[i]);
+      local_of_id_[ids_[i]] = static_cast<std::int64_t>(k);
+      if (i % per_node_ == 0) {
+        x_[k] = in_plane(p.position[s]);
+        v_[k] = in_plane(p.velocity[s]);
+      } else if (in_plane(p.position[s]) != x_[k]) {
+        throw InputError(
+            fmt::format("ElasticRod: particle id {} of body {} is not at the (x, z) of its row's first "
+                        "particle (rows of {} across the width; valid: add_elastic_ribbon)",
+                        ids_[i], body, per_node_));
+      }
+      if (Dim == 3 && (in_plane(p.velocity[s]) != v_[k] || p.velocity[s][Dim - 2] != T(0)))
+        throw InputError(
+            fmt::format("ElasticRod: particle id {} of body {} does not move with its row (valid: the "
+                        "row's particles share one velocity in the x-z plane, zero along y)",
+                        ids_[i], body));
+      lateral_[i] = Dim == 3 ? p.position[s][1] : T(0);
     }
     X_ = x_;
     rest_length_.resize(n - 1);
@@ -186,7 +262,7 @@ class ElasticRod {
         throw InputError(
             fmt::format("ElasticRod: nodes {} and {} of body {} coincide (edge rest length {} m): valid "
                         "range is (0, inf)",
-                        ids_[j], ids_[j + 1], body, rest_length_[j]));
+                        ids_[j * per_node_], ids_[(j + 1) * per_node_], body, rest_length_[j]));
     }
     voronoi_.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
@@ -197,9 +273,7 @@ class ElasticRod {
     const T rho_a = material_.density * params_.section.area();
     mass_.resize(n);
     for (std::size_t i = 0; i < n; ++i) mass_[i] = rho_a * voronoi_[i];
-    inertia_ratio_.resize(n);
-    for (std::size_t i = 0; i < n; ++i)
-      inertia_ratio_[i] = rho_a / (rho_a + params_.added_mass_per_area * params_.section.width);
+    inertia_ratio_.assign(ids_.size(), rho_a / (rho_a + params_.added_mass_per_area * params_.section.width));
     rest_angle_.assign(n, T(0));
     for (std::size_t i = 1; i + 1 < n; ++i) rest_angle_[i] = turning_angle(X_[i] - X_[i - 1], X_[i + 1] - X_[i]);
     held_.assign(n, 0);
@@ -220,11 +294,11 @@ class ElasticRod {
   /// Holds the nodes whose reference position satisfies pred at rest at their reference position. A held end
   /// node (base or tip) also holds the end tangent at its reference direction: that end is clamped (for an end
   /// that is only pinned, hold it and leave the tangent free with pin_where). Returns the number of held nodes.
+  /// In 3D pred sees the rest positions of a node's row; the node is held if any of them satisfies it.
   template <class Predicate>
   std::size_t clamp_where(Predicate&& pred) {
-    const std::size_t n = ids_.size();
-    for (std::size_t k = 0; k < n; ++k)
-      if (pred(X_[k])) held_[k] = 1;
+    const std::size_t n = node_count();
+    pin_where(pred);
     clamped_end_[0] = clamped_end_[0] || held_[0];
     clamped_end_[1] = clamped_end_[1] || held_[n - 1];
     return held_count();
@@ -232,8 +306,8 @@ class ElasticRod {
   /// Holds the nodes whose reference position satisfies pred, without holding the tangent (a pin).
   template <class Predicate>
   std::size_t pin_where(Predicate&& pred) {
-    for (std::size_t k = 0; k < ids_.size(); ++k)
-      if (pred(X_[k])) held_[k] = 1;
+    for (std::size_t i = 0; i < ids_.size(); ++i)
+      if (pred(in_space(X_[i / per_node_], lateral_[i]))) held_[i / per_node_] = 1;
     return held_count();
   }
   /// Moves the held nodes rigidly: each sits at its reference position plus displacement(t) with velocity
@@ -290,7 +364,7 @@ class ElasticRod {
     gather(p, true);
     const std::size_t n_sub = detail::sub_step_count(dt, solid_time_step());
     const T h = dt / T(n_sub);
-    const std::size_t n = ids_.size();
+    const std::size_t n = node_count();
     const Vector g = body_force();
     set_damping_frame(time);
     internal_forces();
@@ -304,7 +378,7 @@ class ElasticRod {
           v_[k] = u;
           continue;
         }
-        v_[k] += (T(0.5) * h * inertia_ratio_[k]) * (a_int_[k] + a_ext_[k] + g);
+        v_[k] += (T(0.5) * h * inertia_ratio_[k * per_node_]) * (a_int_[k] + a_ext_[k] + g);
         x_[k] += h * v_[k];
         if (has_contact_ && (X_[k] - contact_point_).dot(contact_normal_) >= contact_gap_) {
           const T d = (x_[k] - contact_point_).dot(contact_normal_);
@@ -318,7 +392,7 @@ class ElasticRod {
       set_damping_frame(t_end);
       internal_forces();
       for (std::size_t k = 0; k < n; ++k)
-        if (!held_[k]) v_[k] += (T(0.5) * h * inertia_ratio_[k]) * (a_int_[k] + a_ext_[k] + g);
+        if (!held_[k]) v_[k] += (T(0.5) * h * inertia_ratio_[k * per_node_]) * (a_int_[k] + a_ext_[k] + g);
       check_finite(time + T(s + 1) * h);
     }
     sub_steps_ += n_sub;
@@ -336,11 +410,22 @@ class ElasticRod {
 
   // ---- SolidModel ----
   std::int32_t body() const noexcept { return body_; }
-  /// Node ids, base to tip.
+  /// Node ids, base to tip (in 3D node by node, each node's row across the width in increasing y).
   const std::vector<std::uint32_t>& particle_ids() const noexcept { return ids_; }
+  /// Number of nodes (particle_ids().size() / particles_per_node()).
+  std::size_t node_count() const noexcept { return ids_.size() / per_node_; }
+  /// Particles of a node's row across the width: 1 in 2D.
+  std::size_t particles_per_node() const noexcept { return per_node_; }
   /// The rod's edges, base to tip, as pairs of node ids (a thin structure: the fluid does not interact across them).
-  void structure_edges(std::vector<StructureEdge>& edges) const {
+  /// 2D only: the visibility criterion and the guard are planar (fluid/thin_structure_visibility.hpp).
+  void structure_edges(std::vector<StructureEdge>& edges) const requires(Dim == 2) {
     for (std::size_t j = 0; j + 1 < ids_.size(); ++j) edges.push_back({ids_[j], ids_[j + 1]});
+  }
+  /// Lateral extent of a ribbon's strip, (lowest, highest) y of its width b, m (3D only).
+  std::pair<T, T> lateral_extent() const requires(Dim == 3) {
+    const auto [lo, hi] = std::minmax_element(lateral_.begin(), lateral_.begin() + std::ptrdiff_t(per_node_));
+    const T centre = T(0.5) * (*lo + *hi), half = T(0.5) * params_.section.width;
+    return {centre - half, centre + half};
   }
   /// Mean rest edge length ds, m.
   T reference_spacing() const {
@@ -370,7 +455,7 @@ class ElasticRod {
   /// Largest edge stretch l_j / L_j (1 for the rest length; > 1 in tension).
   T max_stretch() const {
     T s = T(0);
-    for (std::size_t j = 0; j + 1 < ids_.size(); ++j) s = std::max(s, (x_[j + 1] - x_[j]).norm() / rest_length_[j]);
+    for (std::size_t j = 0; j + 1 < node_count(); ++j) s = std::max(s, (x_[j + 1] - x_[j]).norm() / rest_length_[j]);
     return s;
   }
 
@@ -381,15 +466,16 @@ class ElasticRod {
   T bending_moment(std::uint32_t id) const { return moment_[local(id)]; }
   /// Position of the tip node (last in id order), m.
   const Vector& tip_position() const { return x_.back(); }
-  /// Rest positions of the nodes, base to tip, m.
+  /// Rest positions of the nodes, base to tip, m (in the rod's plane: (x, z) in 3D).
   const std::vector<Vector>& reference_positions() const noexcept { return X_; }
   /// Current node positions and velocities, base to tip (as of the last compute_rates / advance).
   const std::vector<Vector>& positions() const noexcept { return x_; }
   const std::vector<Vector>& velocities() const noexcept { return v_; }
   /// Node masses m_i = rho A D_i of the real blade (width b), kg.
   const std::vector<T>& node_masses() const noexcept { return mass_; }
-  /// Per node, m_i / (m_i + m_a b D_i): the share of a force on the node's own mass that becomes its acceleration
-  /// (1 without added inertia). Couplings use it for their step limit (coupling/repulsive_force.hpp).
+  /// Per particle (in particle_ids() order), m_i / (m_i + m_a b D_i): the share of a force on the node's own mass
+  /// that becomes its acceleration (1 without added inertia). Couplings use it for their step limit
+  /// (coupling/repulsive_force.hpp).
   const std::vector<T>& inertia_ratios() const noexcept { return inertia_ratio_; }
   /// E_r: E, or E / (1 - nu^2) in plane strain, Pa.
   T modulus() const { return params_.plane_strain ? material_.plane_strain_modulus() : material_.youngs_modulus; }
@@ -402,12 +488,12 @@ class ElasticRod {
   /// Kinetic energy sum m v^2 / 2 of the real blade, J.
   T kinetic_energy() const {
     T e = T(0);
-    for (std::size_t k = 0; k < ids_.size(); ++k) e += T(0.5) * mass_[k] * v_[k].squaredNorm();
+    for (std::size_t k = 0; k < node_count(); ++k) e += T(0.5) * mass_[k] * v_[k].squaredNorm();
     return e;
   }
   /// Stored elastic energy U (stretching plus bending), J.
   T strain_energy() const {
-    const std::size_t n = ids_.size();
+    const std::size_t n = node_count();
     const T ea = modulus() * params_.section.area(), ei = bending_stiffness();
     T e = T(0);
     for (std::size_t j = 0; j + 1 < n; ++j) {
@@ -423,14 +509,15 @@ class ElasticRod {
   /// Potential energy of the body force, -sum m (1 - rho_w/rho) g . x, J.
   T potential_energy() const {
     T e = T(0);
-    for (std::size_t k = 0; k < ids_.size(); ++k) e -= mass_[k] * body_force().dot(x_[k]);
+    for (std::size_t k = 0; k < node_count(); ++k) e -= mass_[k] * body_force().dot(x_[k]);
     return e;
   }
   std::size_t sub_step_total() const noexcept { return sub_steps_; }
-  /// Total force the couplings exert on the rod (all nodes, held ones included), N per unit depth in 2D: the sum
-  /// of m_i a_i over the nodes of the force per unit mass found in the particle set after the rate evaluation.
-  Vector coupling_force(const ParticleSet<2, T>& p) const {
-    Vector f = Vector::Zero();
+  /// Total force the couplings exert on the rod (all nodes, held ones included), N per unit depth in 2D, N in 3D:
+  /// the sum of m_i a_i over the particles of the force per unit mass found in the particle set after the rate
+  /// evaluation.
+  SpaceVector coupling_force(const ParticleSet<Dim, T>& p) const {
+    SpaceVector f = SpaceVector::Zero();
     for (const std::uint32_t id : ids_) {
       const std::size_t s = p.slot_of_id(id);
       f += p.mass[s] * p.acceleration[s];
@@ -457,11 +544,11 @@ class ElasticRod {
       r.fail(fmt::format("elastic rod of body {}: the file holds {} nodes with other ids than this rod's {}", body_,
                          ids.size(), ids_.size()));
     std::vector<std::uint8_t> held, ends;
-    r.read_exact("elastic_rod.held", held, ids_.size());
+    r.read_exact("elastic_rod.held", held, node_count());
     r.read_exact("elastic_rod.clamped_ends", ends, 2);
     std::vector<Vector> x, v;
-    r.read_exact("elastic_rod.position", x, ids_.size());
-    r.read_exact("elastic_rod.velocity", v, ids_.size());
+    r.read_exact("elastic_rod.position", x, node_count());
+    r.read_exact("elastic_rod.velocity", v, node_count());
     std::uint64_t sub_steps = 0;
     r.read("elastic_rod.sub_steps", sub_steps);
     held_ = std::move(held);
@@ -478,6 +565,15 @@ class ElasticRod {
     return std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b));
   }
   static Vector perp(const Vector& e) { return Vector(-e.y(), e.x()); }
+  /// (x, z) of a point in space, and the point of the rod's plane at lateral position y.
+  static Vector in_plane(const SpaceVector& x) {
+    if constexpr (Dim == 2) return x;
+    else return Vector(x[0], x[2]);
+  }
+  static SpaceVector in_space(const Vector& x, T lateral) {
+    if constexpr (Dim == 2) return x;
+    else return SpaceVector(x[0], lateral, x[1]);
+  }
   void set_damping_frame(T t) {
     damping_frame_ = params_.damping_relative_to_clamp && clamp_velocity_ ? clamp_velocity_(t) : Vector::Zero();
   }
@@ -496,7 +592,7 @@ class ElasticRod {
   /// phi_i - phi0_i at node i: the turning angle at an interior node, the angle between the held tangent and the
   /// end edge at a clamped end, 0 at a free end.
   T bending_angle(std::size_t i) const {
-    const std::size_t n = ids_.size();
+    const std::size_t n = node_count();
     if (i == 0) return clamped_end_[0] ? turning_angle(held_tangent_[0], x_[1] - x_[0]) : T(0);
     if (i == n - 1) return clamped_end_[1] ? turning_angle(x_[n - 1] - x_[n - 2], held_tangent_[1]) : T(0);
     return turning_angle(x_[i] - x_[i - 1], x_[i + 1] - x_[i]) - rest_angle_[i];
@@ -504,7 +600,7 @@ class ElasticRod {
 
   /// Axial forces, bending moments and the internal (elastic + damping) acceleration at the current state.
   void internal_forces() {
-    const std::size_t n = ids_.size();
+    const std::size_t n = node_count();
     const T ea = modulus() * params_.section.area(), ei = bending_stiffness();
     for (std::size_t i = 0; i < n; ++i) moment_[i] = ei * bending_angle(i) / voronoi_[i];
     for (auto& a : a_int_) a.setZero();
@@ -521,42 +617,58 @@ class ElasticRod {
   }
 
   T node_axial_force(std::size_t k) const {
-    const std::size_t n = ids_.size();
+    const std::size_t n = node_count();
     if (k == 0) return axial_force_[0];
     if (k == n - 1) return axial_force_[n - 2];
     return T(0.5) * (axial_force_[k - 1] + axial_force_[k]);
   }
   /// Unit tangent at a node (mean direction of its edges), base to tip.
   Vector tangent(std::size_t k) const {
-    const std::size_t n = ids_.size();
+    const std::size_t n = node_count();
     if (k == 0) return (x_[1] - x_[0]).normalized();
     if (k == n - 1) return (x_[n - 1] - x_[n - 2]).normalized();
     return ((x_[k] - x_[k - 1]).normalized() + (x_[k + 1] - x_[k]).normalized()).normalized();
   }
 
-  void gather(const ParticleSet<2, T>& p, bool external) {
-    for (std::size_t k = 0; k < ids_.size(); ++k) {
-      const std::size_t s = p.slot_of_id(ids_[k]);
-      x_[k] = p.position[s];
-      v_[k] = p.velocity[s];
-      if (external) a_ext_[k] = held_[k] ? Vector::Zero() : p.acceleration[s];
+  /// Node state from the first particle of each row; the external acceleration is the row's mass-weighted mean (in
+  /// 2D the node's own).
+  void gather(const ParticleSet<Dim, T>& p, bool external) {
+    for (std::size_t k = 0; k < node_count(); ++k) {
+      const std::size_t s = p.slot_of_id(ids_[k * per_node_]);
+      x_[k] = in_plane(p.position[s]);
+      v_[k] = in_plane(p.velocity[s]);
+      if (!external) continue;
+      if (held_[k]) {
+        a_ext_[k] = Vector::Zero();
+      } else if (per_node_ == 1) {
+        a_ext_[k] = in_plane(p.acceleration[s]);
+      } else {
+        Vector force = Vector::Zero();
+        T mass = T(0);
+        for (std::size_t j = 0; j < per_node_; ++j) {
+          const std::size_t r = p.slot_of_id(ids_[k * per_node_ + j]);
+          force += p.mass[r] * in_plane(p.acceleration[r]);
+          mass += p.mass[r];
+        }
+        a_ext_[k] = force / mass;
+      }
     }
   }
-  void scatter(ParticleSet<2, T>& p) const {
-    for (std::size_t k = 0; k < ids_.size(); ++k) {
-      const std::size_t s = p.slot_of_id(ids_[k]);
-      p.position[s] = x_[k];
-      p.velocity[s] = v_[k];
+  void scatter(ParticleSet<Dim, T>& p) const {
+    for (std::size_t i = 0; i < ids_.size(); ++i) {
+      const std::size_t s = p.slot_of_id(ids_[i]);
+      p.position[s] = in_space(x_[i / per_node_], lateral_[i]);
+      p.velocity[s] = in_space(v_[i / per_node_], T(0));
     }
   }
   /// Writes the blade normal, density rho / stretch, pressure -(N/A)/2 (the section-mean stress: the bending
   /// stress averages to zero over the thickness) and the bar wave speed sqrt(E_r / rho) of every node.
-  void publish(ParticleSet<2, T>& p) const {
+  void publish(ParticleSet<Dim, T>& p) const {
     const T c = std::sqrt(modulus() / material_.density);
-    for (std::size_t k = 0; k < ids_.size(); ++k) {
-      const std::size_t s = p.slot_of_id(ids_[k]);
+    for (std::size_t i = 0; i < ids_.size(); ++i) {
+      const std::size_t s = p.slot_of_id(ids_[i]), k = i / per_node_;
       const T n_k = node_axial_force(k);
-      p.normal[s] = perp(tangent(k));
+      p.normal[s] = in_space(perp(tangent(k)), T(0));
       p.density[s] = material_.density / (T(1) + n_k / (modulus() * params_.section.area()));
       p.pressure[s] = -T(0.5) * n_k / params_.section.area();
       p.sound_speed[s] = c;
@@ -564,24 +676,26 @@ class ElasticRod {
   }
 
   void check_finite(T time) const {
-    for (std::size_t k = 0; k < ids_.size(); ++k)
+    for (std::size_t k = 0; k < node_count(); ++k)
       if (!x_[k].allFinite() || !v_[k].allFinite())
-        throw BlowUpError(
-            fmt::format("elastic rod blow-up at t = {:.6g} s: body {} node id {} (node {} of {}) has a "
-                        "non-finite {}; the particle set holds the state at the start of the outer step",
-                        time, body_, ids_[k], k, ids_.size(), x_[k].allFinite() ? "velocity" : "position"));
+        throw BlowUpError(fmt::format(
+            "elastic rod blow-up at t = {:.6g} s: body {} node id {} (node {} of {}) has a "
+            "non-finite {}; the particle set holds the state at the start of the outer step",
+            time, body_, ids_[k * per_node_], k, node_count(), x_[k].allFinite() ? "velocity" : "position"));
   }
 
   ElasticMaterial<T> material_;
   Parameters params_;
   std::int32_t body_;
-  std::vector<std::uint32_t> ids_;                 // node ids, base to tip
+  std::vector<std::uint32_t> ids_;                 // particle ids, base to tip, row by row in 3D
+  std::size_t per_node_{1};                        // particles per node (its row across the width in 3D)
+  std::vector<T> lateral_;                         // per particle: its y (3D), m
   std::vector<std::int64_t> local_of_id_;          // node index of a particle id, -1 if not a node
   std::vector<Vector> X_, x_, v_;                  // rest and current positions (m), velocities (m/s)
   std::vector<T> rest_length_;                     // L_j, m
   std::vector<T> voronoi_;                         // D_i, m
   std::vector<T> mass_;                            // m_i = rho A D_i, kg
-  std::vector<T> inertia_ratio_;                   // m_i / (m_i + m_a b D_i) (1 without added mass)
+  std::vector<T> inertia_ratio_;                   // per particle: m_i / (m_i + m_a b D_i) (1 without added mass)
   std::vector<T> rest_angle_;                      // phi0_i, rad
   std::vector<std::uint8_t> held_;                 // 1: node held at rest at X
   std::array<bool, 2> clamped_end_{false, false};  // base, tip: tangent held
