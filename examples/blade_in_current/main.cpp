@@ -251,8 +251,7 @@ CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
   FluidParameters<Dim, T> fluid;
   fluid.gravity = VD::Zero();
   fluid.artificial_viscosity = o.artificial_viscosity;
-  // the fluid passes a porous blade; the visibility criterion and the guard are planar (2D blades only)
-  fluid.thin_structure_visibility = Dim == 2 && o.visibility && !porous;
+  fluid.thin_structure_visibility = o.visibility && !porous;  // the fluid passes a porous blade
   fluid.thin_structure_guard = o.guard;
   fluid.background_pressure = o.background_pressure * rho * U * U;
   Coupling coupling;

@@ -352,3 +352,59 @@ TEST_CASE("thin-structure guard: candidate lists rebuilt after the particle set 
   CHECK(fluid.keep_fluid_beside_structures(system) == 1);
   CHECK(p.position[p.slot_of_id(through)][0] == Approx(-0.001).margin(1e-12));
 }
+
+// ---- 3D ribbons: strip elements with lateral bands ----
+
+TEST_CASE("visibility and guard in 3D: a ribbon hides pairs and stops steps through its strip, not beside it",
+          "[visibility][guard][ribbon]") {
+  using System3 = ParticleSystem<3, double, WendlandC2<3>, Tait<double>>;
+  using V3 = Vec<3, double>;
+  using Ribbon = ElasticRod<System3>;
+  System3 system(Domain<3, double>(V3(-0.1, -0.1, -0.1), V3(0.2, 0.2, 0.2)), Tait<double>(1000, 20));
+  const double h = 0.0065;
+  // A strip 1 cm wide (y in [-0.005, 0.005]) standing at x = 0, 0.1 m tall, 21 rows of 4 particles.
+  add_elastic_ribbon(system, V(0, 0), V(0, 1), 0.1, 21, 4, 0.0, blade_material(), blade_section(), h, 1);
+  Ribbon ribbon(system, 1, blade_material(), {.section = blade_section()});
+  std::vector<StructureEdge> edges;
+  std::vector<std::array<double, 2>> bands;
+  ribbon.structure_edges(edges, bands);
+  REQUIRE(edges.size() == 20 * 4);
+  CHECK(bands.front()[0] == Approx(-0.005));
+  CHECK(bands[1][0] == Approx(-0.0025));  // half-way between the rows at y = -0.00375 and -0.00125
+  CHECK(bands[3][1] == Approx(0.005));
+  auto& p = system.particles();
+  const auto fluid = [&](V3 x) { return p.id[p.add(Kind::fluid, x, V3::Zero(), 1000, 1.25e-4, h)]; };
+  const std::uint32_t a = fluid(V3(-0.003, 0.002, 0.05)), b = fluid(V3(0.003, -0.001, 0.05));  // across the strip
+  const std::uint32_t c = fluid(V3(-0.003, 0.007, 0.05)), d = fluid(V3(0.003, 0.007, 0.05));   // beside it
+  const std::uint32_t e = fluid(V3(-0.003, 0.004, 0.05)), f = fluid(V3(0.003, 0.008, 0.05));   // meets y = 0.006
+  system.update_neighbors();
+  ThinStructureVisibility<double, 3> visibility;
+  CHECK_THROWS_WITH(visibility.set_edges(edges), Catch::Contains("lateral bands"));
+  visibility.set_edges(edges, bands);
+  visibility.update(system);
+  const auto hidden = [&](std::uint32_t i, std::uint32_t j) {
+    const std::size_t si = p.slot_of_id(i), sj = p.slot_of_id(j);
+    return visibility.blocks(si, sj, p.position[si], p.position[sj]);
+  };
+  CHECK(hidden(a, b));
+  CHECK_FALSE(hidden(c, d));
+  CHECK_FALSE(hidden(e, f));  // crosses the strip's plane at y = 0.006, past its edge at 0.005
+  // The guard: a, c, e step through the plane x = 0; a and e within the strip (y 0.002 and 0.004 when they meet it)
+  // are put back, c beside the strip (y = 0.007) is not.
+  ThinStructureGuard<double, 3> guard;
+  for (std::size_t i = 0; i < p.size(); ++i) p.position_old[i] = p.position[i];
+  p.position[p.slot_of_id(a)] = V3(0.001, 0.002, 0.051);
+  p.velocity[p.slot_of_id(a)] = V3(0.4, 0.1, 0.1);
+  p.position[p.slot_of_id(c)] = V3(0.001, 0.007, 0.05);
+  p.position[p.slot_of_id(e)] = V3(0.001, 0.0045, 0.05);
+  CHECK(guard.restore(p, visibility) == 2);
+  const V3 xa = p.position[p.slot_of_id(a)], va = p.velocity[p.slot_of_id(a)];
+  CHECK(xa.x() == Approx(-0.003).margin(1e-12));  // back at its start distance from the strip
+  CHECK(xa.y() == 0.002);                         // y and z as moved
+  CHECK(xa.z() == 0.051);
+  CHECK(va.x() == Approx(0).margin(1e-12));  // the normal velocity towards the strip removed
+  CHECK(va.y() == 0.1);
+  CHECK(va.z() == 0.1);
+  CHECK(p.position[p.slot_of_id(c)] == V3(0.001, 0.007, 0.05));
+  CHECK(p.position[p.slot_of_id(e)].x() < 0);
+}

@@ -59,6 +59,12 @@ class CoupledBody {
   void structure_edges(Edges& edges) const {
     if constexpr (!permeable_coupling<Coupling>) solid_.structure_edges(edges);
   }
+  /// The same for a 3D ribbon: its edges and their lateral bands.
+  template <class Edges, class Bands>
+    requires requires(const Solid& s, Edges& e, Bands& b) { s.structure_edges(e, b); }
+  void structure_edges(Edges& edges, Bands& bands) const {
+    if constexpr (!permeable_coupling<Coupling>) solid_.structure_edges(edges, bands);
+  }
 
   Solid& solid() noexcept { return solid_; }
   const Solid& solid() const noexcept { return solid_; }

@@ -1,4 +1,4 @@
-// sphfsi: a guard that keeps fluid particles on their own face of a thin structure (2D).
+// sphfsi: a guard that keeps fluid particles on their own face of a thin structure (2D blades, 3D ribbons).
 //
 // With the visibility criterion (thin_structure_visibility.hpp) the fluid on one face of a blade does not see the
 // fluid on the other, so what keeps a particle on its face is the coupling's push from the line of nodes alone
@@ -19,6 +19,9 @@
 // still meets an edge then keeps its start offset from the point of the edge it met (it moves with the edge;
 // counted by moved_with_edge()). The impulse is given to the fluid particle only (the blade does not feel
 // it), so the guard is a last resort whose use is counted (crossings_prevented()): the coupling should make it rare.
+// In 3D (ribbons bending in the x-z plane: thin_structure_visibility.hpp) the same test runs on the x-z projections,
+// and a meeting counts only where the particle's y at the meeting time lies in the edge's lateral band; the put-back
+// moves the particle and changes its velocity in the x-z plane only.
 #pragma once
 
 #include <sphfsi/core/error.hpp>
@@ -37,10 +40,11 @@
 namespace sphfsi {
 
 /// Puts back the fluid particles that stepped through a thin structure (see the header comment).
-template <Real T>
+template <Real T, int Dim = 2>
 class ThinStructureGuard {
  public:
-  using Vector = Vec<2, T>;
+  using Vector = Vec<2, T>;  ///< in the structures' plane: (x, vertical)
+  using Visibility = ThinStructureVisibility<T, Dim>;
 
   /// Where and when a moving point met a moving segment within a step.
   struct Meeting {
@@ -95,7 +99,7 @@ class ThinStructureGuard {
   /// After a step: p.position_old and p.position hold every particle's positions at its start and end, the
   /// visibility's candidate edges are those of this step's neighbours. Returns the particles put back.
   template <class Particles>
-  std::size_t restore(Particles& p, const ThinStructureVisibility<T>& visibility) {
+  std::size_t restore(Particles& p, const Visibility& visibility) {
     const auto& edges = visibility.edges();
     slots_.resize(edges.size());
     for (std::size_t k = 0; k < edges.size(); ++k) slots_[k] = {p.slot_of_id(edges[k][0]), p.slot_of_id(edges[k][1])};
@@ -111,9 +115,11 @@ class ThinStructureGuard {
       for (int put_backs = 0; edge >= 0; edge = first_meeting(p, visibility, f, first)) {
         if (put_backs++ == 3) {  // still crossing: keep its start offset from the point of the edge it met
           const auto [s0, s1] = slots_[edge];
-          const Vector then = (T(1) - first.along) * p.position_old[s0] + first.along * p.position_old[s1];
-          const Vector now = (T(1) - first.along) * p.position[s0] + first.along * p.position[s1];
-          p.position[f] = p.position_old[f] + (now - then);
+          const Vector then =
+              (T(1) - first.along) * plane(p.position_old[s0]) + first.along * plane(p.position_old[s1]);
+          const Vector now = (T(1) - first.along) * plane(p.position[s0]) + first.along * plane(p.position[s1]);
+          p.position[f] = p.position_old[f];
+          add_in_plane(p.position[f], now - then);
           rode.fetch_add(1, std::memory_order_relaxed);
           break;
         }
@@ -133,16 +139,25 @@ class ThinStructureGuard {
  private:
   /// The candidate edge slot f's path met first this step (-1: none), and the meeting.
   template <class Particles>
-  std::int32_t first_meeting(const Particles& p, const ThinStructureVisibility<T>& visibility, std::size_t f,
-                             Meeting& first) const {
+  std::int32_t first_meeting(const Particles& p, const Visibility& visibility, std::size_t f, Meeting& first) const {
     std::int32_t edge = -1;
     visibility.for_each_candidate(f, [&](std::int32_t e) {
       const auto [s0, s1] = slots_[e];
-      const Meeting m = crossing(p.position_old[f], p.position[f], p.position_old[s0], p.position[s0],
-                                 p.position_old[s1], p.position[s1]);
-      if (m.time > T(0) && (edge < 0 || m.time < first.time)) first = m, edge = e;
+      const Meeting m = crossing(plane(p.position_old[f]), plane(p.position[f]), plane(p.position_old[s0]),
+                                 plane(p.position[s0]), plane(p.position_old[s1]), plane(p.position[s1]));
+      if (!(m.time > T(0))) return;
+      if constexpr (Dim == 3) {  // the particle's y when it met the edge's line must lie in the edge's band
+        const T y = p.position_old[f][1] + m.time * (p.position[f][1] - p.position_old[f][1]);
+        if (y < visibility.band(std::size_t(e))[0] || y > visibility.band(std::size_t(e))[1]) return;
+      }
+      if (edge < 0 || m.time < first.time) first = m, edge = e;
     });
     return edge;
+  }
+  static Vector plane(const Vec<Dim, T>& x) { return Visibility::in_plane(x); }
+  static void add_in_plane(Vec<Dim, T>& x, const Vector& d) {
+    x[0] += d[0];
+    x[Dim - 1] += d[1];
   }
 
   /// Back across the line of the edge it met, at the distance it had from that line at the start of the step; its
@@ -150,14 +165,14 @@ class ThinStructureGuard {
   template <class Particles>
   void put_back_across(Particles& p, std::size_t f, std::int32_t edge, const Meeting& first) const {
     const auto [s0, s1] = slots_[edge];
-    const Vector a = p.position[s0], t = p.position[s1] - a;
+    const Vector a = plane(p.position[s0]), t = plane(p.position[s1]) - a;
     const T length = t.norm();
     const Vector normal = Vector(-t[1], t[0]) / length * first.side;  // towards the starting face
-    const T offset = (p.position[f] - a).dot(normal);                 // <= 0: on the wrong side of the line
-    p.position[f] += (std::max(first.offset, min_offset_ * length) - offset) * normal;
-    const Vector edge_velocity = (T(1) - first.along) * p.velocity[s0] + first.along * p.velocity[s1];
-    const T towards_wrong_face = (p.velocity[f] - edge_velocity).dot(normal);
-    if (towards_wrong_face < T(0)) p.velocity[f] -= towards_wrong_face * normal;
+    const T offset = (plane(p.position[f]) - a).dot(normal);          // <= 0: on the wrong side of the line
+    add_in_plane(p.position[f], (std::max(first.offset, min_offset_ * length) - offset) * normal);
+    const Vector edge_velocity = (T(1) - first.along) * plane(p.velocity[s0]) + first.along * plane(p.velocity[s1]);
+    const T towards_wrong_face = (plane(p.velocity[f]) - edge_velocity).dot(normal);
+    if (towards_wrong_face < T(0)) add_in_plane(p.velocity[f], -towards_wrong_face * normal);
   }
 
   std::vector<std::array<std::size_t, 2>> slots_;

@@ -1,4 +1,4 @@
-// sphfsi: a visibility criterion for particle pairs across thin structures (2D).
+// sphfsi: a visibility criterion for particle pairs across thin structures (2D blades, 3D ribbons).
 //
 // A blade modelled as one line of nodes (solid/elastic_rod.hpp) has no particles of its own between its faces: the
 // fluid particles on its two faces are within each other's kernel support and, without a criterion, interact
@@ -20,6 +20,13 @@
 // shorter than sqrt(3) x support, within the support of one of that edge's nodes: testing the candidates of both
 // particles finds every blocked pair. Edges are given once as pairs of particle ids (they do not change over a
 // run); their end points are read from the current positions at every evaluation.
+//
+// In 3D the structures are ribbons (solid/elastic_rod.hpp): strips bending in the x-z plane. An edge is then a strip
+// element, the segment between two particles of consecutive rows swept along y over its lateral band [lo, hi] (the
+// share of the width that particle stands for). A pair is blocked when its projection on the x-z plane crosses the
+// edge's segment (the 2D test above) at a point whose y, interpolated along the pair, lies in the band. The
+// candidate search is the same; with bands no wider than the rows' spacing the closer particle of a blocked pair is
+// within the support of one of the edge's two particles for the same edge lengths.
 #pragma once
 
 #include <sphfsi/core/error.hpp>
@@ -27,6 +34,7 @@
 #include <sphfsi/kernel/concepts.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -34,14 +42,36 @@
 namespace sphfsi {
 
 /// Which pairs of particles a set of thin-structure edges hides from each other (see the header comment).
-template <Real T>
+template <Real T, int Dim = 2>
 class ThinStructureVisibility {
  public:
-  using Vector = Vec<2, T>;
+  static_assert(Dim == 2 || Dim == 3, "ThinStructureVisibility: 2D blades or 3D ribbons");
+  using Vector = Vec<2, T>;  ///< in the structure's plane: (x, vertical)
+  using SpaceVector = Vec<Dim, T>;
+  using Band = std::array<T, 2>;
 
-  /// Replaces the edges (ids of their end nodes; the nodes must be particles of the system).
-  void set_edges(std::vector<StructureEdge> edges) { edges_ = std::move(edges); }
+  /// Replaces the edges (ids of their end nodes; the nodes must be particles of the system). In 3D each edge has
+  /// its lateral band [lo, hi] along y (lo < hi), one per edge.
+  void set_edges(std::vector<StructureEdge> edges, std::vector<Band> bands = {}) {
+    if (Dim == 3 && bands.size() != edges.size())
+      throw InputError(
+          fmt::format("ThinStructureVisibility: {} edges with {} lateral bands (valid: in 3D one band "
+                      "[lo, hi] per edge; in 2D none)",
+                      edges.size(), bands.size()));
+    if (Dim == 2 && !bands.empty())
+      throw InputError("ThinStructureVisibility: lateral bands are for 3D ribbons (valid in 2D: none)");
+    for (std::size_t k = 0; k < bands.size(); ++k)
+      if (!(bands[k][0] < bands[k][1]) || !std::isfinite(bands[k][0]) || !std::isfinite(bands[k][1]))
+        throw InputError(
+            fmt::format("ThinStructureVisibility: edge {} has the lateral band [{}, {}] m (valid: finite, "
+                        "lo < hi)",
+                        k, bands[k][0], bands[k][1]));
+    edges_ = std::move(edges);
+    bands_ = std::move(bands);
+  }
   const std::vector<StructureEdge>& edges() const noexcept { return edges_; }
+  /// Lateral band of edge k (3D), m.
+  const Band& band(std::size_t k) const { return bands_[k]; }
   bool active() const noexcept { return !edges_.empty(); }
 
   /// Reads the edges' end points and builds each particle's candidate edges from the nodes' neighbour lists
@@ -64,8 +94,8 @@ class ThinStructureVisibility {
                           k, edges_[k][end]));
       }
       const std::size_t s0 = p.slot_of_id(edges_[k][0]), s1 = p.slot_of_id(edges_[k][1]);
-      from_[k] = p.position[s0];
-      to_[k] = p.position[s1];
+      from_[k] = in_plane(p.position[s0]);
+      to_[k] = in_plane(p.position[s1]);
       // The candidate search finds every hidden pair only for edges up to sqrt(3) x the nodes' support radius.
       const T reach =
           support_radius<typename System::kernel_type>(std::min(p.smoothing_length[s0], p.smoothing_length[s1]));
@@ -75,7 +105,7 @@ class ThinStructureVisibility {
                         "sqrt(3) x the nodes' support radius, {:.4g} m (refine the structure's nodes)",
                         k, double((to_[k] - from_[k]).norm()), double(std::sqrt(T(3)) * reach)));
       for (const std::size_t s : {s0, s1}) {
-        system.for_each_neighbor(s, [&](std::size_t f, const Vector&, T, T) {
+        system.for_each_neighbor(s, [&](std::size_t f, const SpaceVector&, T, T) {
           if (p.kind[f] == Kind::solid) return;
           for (std::int32_t e = head_[f]; e >= 0; e = entries_[e].next)
             if (entries_[e].edge == std::int32_t(k)) return;
@@ -103,8 +133,14 @@ class ThinStructureVisibility {
   }
 
   /// Whether the pair (a at xa, b at xb) is hidden by an edge: tests the candidates of both particles.
-  bool blocks(std::size_t a, std::size_t b, const Vector& xa, const Vector& xb) const noexcept {
+  bool blocks(std::size_t a, std::size_t b, const SpaceVector& xa, const SpaceVector& xb) const noexcept {
     return crosses_any(head_[a], xa, xb) || crosses_any(head_[b], xa, xb);
+  }
+
+  /// (x, z) of a point in space: the plane the structures bend in.
+  static Vector in_plane(const SpaceVector& x) noexcept {
+    if constexpr (Dim == 2) return x;
+    else return Vector(x[0], x[2]);
   }
 
   /// Whether the pair segment p0 p1 crosses the edge q0 q1: p0, p1 strictly on opposite sides of the edge's line,
@@ -123,13 +159,26 @@ class ThinStructureVisibility {
   struct Entry {
     std::int32_t edge, next;
   };
-  bool crosses_any(std::int32_t e, const Vector& xa, const Vector& xb) const noexcept {
-    for (; e >= 0; e = entries_[e].next)
-      if (segments_cross(xa, xb, from_[entries_[e].edge], to_[entries_[e].edge])) return true;
+  bool crosses_any(std::int32_t e, const SpaceVector& xa, const SpaceVector& xb) const noexcept {
+    const Vector pa = in_plane(xa), pb = in_plane(xb);
+    for (; e >= 0; e = entries_[e].next) {
+      const std::int32_t k = entries_[e].edge;
+      if (!segments_cross(pa, pb, from_[k], to_[k])) continue;
+      if constexpr (Dim == 2) {
+        return true;
+      } else {  // where along the pair it meets the edge's line, and that point's y
+        const Vector u = to_[k] - from_[k];
+        const T da = u[0] * (pa[1] - from_[k][1]) - u[1] * (pa[0] - from_[k][0]);
+        const T db = u[0] * (pb[1] - from_[k][1]) - u[1] * (pb[0] - from_[k][0]);
+        const T y = xa[1] + (da / (da - db)) * (xb[1] - xa[1]);
+        if (y >= bands_[k][0] && y <= bands_[k][1]) return true;
+      }
+    }
     return false;
   }
 
   std::vector<StructureEdge> edges_;
+  std::vector<Band> bands_;         // 3D: lateral band of each edge
   std::vector<Vector> from_, to_;   // current end points of each edge
   std::vector<std::int32_t> head_;  // per slot: first candidate entry, -1: none
   std::vector<std::uint32_t> ids_;  // particle id per slot at update()

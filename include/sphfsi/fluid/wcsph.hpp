@@ -50,6 +50,7 @@
 #include <Eigen/LU>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -157,32 +158,28 @@ class WcsphFluid {
   /// Restores the signal speeds saved with signal_speeds() (io/checkpoint.hpp).
   void restore_signal_speeds(std::vector<T> speeds) { signal_speed_ = std::move(speeds); }
 
-  /// Edges of thin structures (pairs of node ids) that hide fluid and wall pairs from each other (2D; see the
-  /// header comment and FluidParameters::thin_structure_visibility). An empty list removes them.
-  void set_structure_edges(std::vector<StructureEdge> edges) {
-    if (Dim != 2 && !edges.empty())
-      throw InputError("WcsphFluid::set_structure_edges: thin-structure visibility is 2D only (valid: Dim = 2)");
-    visibility_.set_edges(std::move(edges));
+  /// Edges of thin structures (pairs of node ids) that hide fluid and wall pairs from each other (see the header
+  /// comment and FluidParameters::thin_structure_visibility); in 3D with each edge's lateral band (a ribbon's strip
+  /// element, fluid/thin_structure_visibility.hpp). An empty list removes them.
+  void set_structure_edges(std::vector<StructureEdge> edges, std::vector<std::array<T, 2>> bands = {}) {
+    visibility_.set_edges(std::move(edges), std::move(bands));
   }
-  const ThinStructureVisibility<T>& structure_visibility() const noexcept { return visibility_; }
+  const ThinStructureVisibility<T, Dim>& structure_visibility() const noexcept { return visibility_; }
 
   /// After a step (positions at its start in position_old): puts back the fluid particles that stepped through a
   /// thin structure (FluidParameters::thin_structure_guard); returns how many. Needs this step's compute_rates and a
   /// neighbour index that fits the particles as they are now.
   std::size_t keep_fluid_beside_structures(System& system) {
-    if constexpr (Dim == 2) {
-      if (!guarded_) return 0;
-      // A model may have split, merged or re-sorted particles since the evaluation (it then rebuilt the neighbour
-      // index): the candidate lists are rebuilt for the particles as they are now.
-      if (!visibility_.matches(system.particles())) visibility_.update(system);
-      return guard_.restore(system.particles(), visibility_);
-    }
-    return 0;
+    if (!guarded_) return 0;
+    // A model may have split, merged or re-sorted particles since the evaluation (it then rebuilt the neighbour
+    // index): the candidate lists are rebuilt for the particles as they are now.
+    if (!visibility_.matches(system.particles())) visibility_.update(system);
+    return guard_.restore(system.particles(), visibility_);
   }
   /// Fluid particles put back by keep_fluid_beside_structures since construction.
   std::size_t structure_crossings_prevented() const noexcept { return guard_.crossings_prevented(); }
   /// The guard itself (its counts).
-  const ThinStructureGuard<T>& structure_guard() const noexcept { return guard_; }
+  const ThinStructureGuard<T, Dim>& structure_guard() const noexcept { return guard_; }
 
   /// Overwrites acceleration, density_rate and xsph_velocity of fluid and wall particles
   /// (pressure and sound speed must be current: System::update_pressure(), neighbours too:
@@ -225,12 +222,9 @@ class WcsphFluid {
       p.xsph_velocity[a] = Vector::Zero();
     });
     if (params_.gradient_correction != GradientCorrection::none) update_gradient_correction(system);
-    occluded_ = guarded_ = false;
-    if constexpr (Dim == 2) {
-      occluded_ = params_.thin_structure_visibility && visibility_.active();
-      guarded_ = params_.thin_structure_guard && visibility_.active();
-      if (occluded_ || guarded_) visibility_.update(system);  // the guard uses the same candidate edges
-    }
+    occluded_ = params_.thin_structure_visibility && visibility_.active();
+    guarded_ = params_.thin_structure_guard && visibility_.active();
+    if (occluded_ || guarded_) visibility_.update(system);  // the guard uses the same candidate edges
     // A few slot ranges per thread, handed out dynamically: wall particles cost less than fluid ones, and on a
     // shared machine a thread may be descheduled for a while.
     const std::size_t threads = static_cast<std::size_t>(std::max(1, thread_count()));
@@ -492,9 +486,8 @@ class WcsphFluid {
       const bool stepping_b = !(frozen_ && frozen_[b]);
       if (frozen_a && !stepping_b) return;
       if (same_resolution && std::abs(h_a - p.smoothing_length[b]) > same_h_tolerance * h_a) return;
-      if constexpr (Dim == 2) {  // hidden from each other by a thin structure
-        if (occluded_ && (visibility_.near(a) || visibility_.near(b)) && visibility_.blocks(a, b, xa, x[b])) return;
-      }
+      // hidden from each other by a thin structure
+      if (occluded_ && (visibility_.near(a) || visibility_.near(b)) && visibility_.blocks(a, b, xa, x[b])) return;
       const Vector vab = va - v[b];
       if (passive_a && fluid_b && p.passive[b]) {  // both carried (their rates are zeroed): only the time step's
         const T mu = h * vab.dot(dx) * (T(1) / (r * r + T(0.01) * h * h));  // signal speed, as below
@@ -577,17 +570,17 @@ class WcsphFluid {
 
   FluidParameters<Dim, T> params_;
   std::vector<T> signal_speed_;
-  std::vector<T> pressure_term_;           // p / rho^2 per slot, Pa m^6/kg^2
-  std::vector<T> volume_;                  // m / rho per slot
-  std::vector<Spill> spills_;              // one per slot range
-  std::vector<Mat<Dim, T>> correction_;    // L_a per slot (valid where corrected_[a])
-  std::vector<unsigned char> corrected_;   // 1: slot a uses the corrected pressure gradient
-  ThinStructureVisibility<T> visibility_;  // edges of thin structures (2D)
-  ThinStructureGuard<T> guard_;            // keeps the fluid on its face of them
-  bool occluded_{false};                   // this evaluation applies the visibility criterion
-  bool guarded_{false};                    // this evaluation prepared the thin-structure guard
-  const std::uint8_t* frozen_{nullptr};    // during compute_rates: slots that keep their rates (or null)
-  bool frozen_mixed_{false};               // during compute_rates: a frozen slot may pair with a stepping one
+  std::vector<T> pressure_term_;                // p / rho^2 per slot, Pa m^6/kg^2
+  std::vector<T> volume_;                       // m / rho per slot
+  std::vector<Spill> spills_;                   // one per slot range
+  std::vector<Mat<Dim, T>> correction_;         // L_a per slot (valid where corrected_[a])
+  std::vector<unsigned char> corrected_;        // 1: slot a uses the corrected pressure gradient
+  ThinStructureVisibility<T, Dim> visibility_;  // edges of thin structures
+  ThinStructureGuard<T, Dim> guard_;            // keeps the fluid on its face of them
+  bool occluded_{false};                        // this evaluation applies the visibility criterion
+  bool guarded_{false};                         // this evaluation prepared the thin-structure guard
+  const std::uint8_t* frozen_{nullptr};         // during compute_rates: slots that keep their rates (or null)
+  bool frozen_mixed_{false};                    // during compute_rates: a frozen slot may pair with a stepping one
 };
 
 }  // namespace sphfsi

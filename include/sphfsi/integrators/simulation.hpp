@@ -12,6 +12,7 @@
 #include <sphfsi/fluid/wcsph.hpp>
 #include <sphfsi/integrators/concepts.hpp>
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -398,17 +399,21 @@ class Simulation {
   }
 
  private:
-  /// Models with thin structures (`structure_edges(std::vector<StructureEdge>&) const`) publish their edges once;
-  /// the fluid hides pairs across them (fluid/thin_structure_visibility.hpp).
+  /// Models with thin structures (`structure_edges(std::vector<StructureEdge>&) const` in 2D; in 3D
+  /// `structure_edges(edges, bands)` with each edge's lateral band, a ribbon's) publish their edges once; the fluid
+  /// hides pairs across them (fluid/thin_structure_visibility.hpp).
   void collect_structure_edges() {
     edges_collected_ = true;
     std::vector<StructureEdge> edges;
-    std::apply([&](const auto&... m) { (append_structure_edges(m, edges), ...); }, models_);
-    if (!edges.empty()) fluid_.set_structure_edges(std::move(edges));
+    std::vector<std::array<T, 2>> bands;
+    std::apply([&](const auto&... m) { (append_structure_edges(m, edges, bands), ...); }, models_);
+    if (!edges.empty()) fluid_.set_structure_edges(std::move(edges), std::move(bands));
   }
   template <class Model>
-  static void append_structure_edges(const Model& model, std::vector<StructureEdge>& edges) {
-    if constexpr (requires { model.structure_edges(edges); }) model.structure_edges(edges);
+  static void append_structure_edges(const Model& model, std::vector<StructureEdge>& edges,
+                                     std::vector<std::array<T, 2>>& bands) {
+    if constexpr (Dim == 3 && requires { model.structure_edges(edges, bands); }) model.structure_edges(edges, bands);
+    else if constexpr (Dim == 2 && requires { model.structure_edges(edges); }) model.structure_edges(edges);
   }
 
   /// Local time stepping: which particles (by id) start this step inside a fine-step region.

@@ -421,6 +421,22 @@ class ElasticRod {
   void structure_edges(std::vector<StructureEdge>& edges) const requires(Dim == 2) {
     for (std::size_t j = 0; j + 1 < ids_.size(); ++j) edges.push_back({ids_[j], ids_[j + 1]});
   }
+  /// A ribbon's strip elements (3D): per edge of the rod and particle of the row, the edge between that particle and
+  /// the one of the next row, with its lateral band (half-way to the row's neighbouring particles; the outer ones
+  /// reach the strip's edges at +-b/2).
+  void structure_edges(std::vector<StructureEdge>& edges, std::vector<std::array<T, 2>>& bands) const
+      requires(Dim == 3) {
+    const auto [lo, hi] = lateral_extent();
+    const std::size_t w = per_node_;
+    for (std::size_t j = 0; j + 1 < node_count(); ++j) {
+      for (std::size_t r = 0; r < w; ++r) {
+        edges.push_back({ids_[j * w + r], ids_[(j + 1) * w + r]});
+        const T below = r == 0 ? lo : T(0.5) * (lateral_[r - 1] + lateral_[r]);
+        const T above = r + 1 == w ? hi : T(0.5) * (lateral_[r] + lateral_[r + 1]);
+        bands.push_back({below, above});
+      }
+    }
+  }
   /// Lateral extent of a ribbon's strip, (lowest, highest) y of its width b, m (3D only).
   std::pair<T, T> lateral_extent() const requires(Dim == 3) {
     const auto [lo, hi] = std::minmax_element(lateral_.begin(), lateral_.begin() + std::ptrdiff_t(per_node_));
