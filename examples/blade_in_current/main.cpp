@@ -14,6 +14,12 @@
 // with C_D = F_rigid / (rho U^2 l / 2) measured on the rigid blade (per unit width: b cancels in 2D).
 // The Cauchy number is set through E at fixed U, l, t (same Reynolds number for every case).
 //
+// --three-d on: the same tow in a 3D channel of width W (--channel-width, in blade widths) with the blade as a strip of
+// width b in its middle (a ribbon: solid/elastic_rod.hpp, rows of particles across the width; the visibility
+// criterion and the guard with lateral bands). The water then passes the strip's sides, as round the narrow blades of
+// Luhar & Nepf (b / l = 0.2), instead of over the top of a full-width 2D plate; forces are per blade (N) and
+// C_D = F_rigid / (rho U^2 b l / 2).
+//
 // Writes <output>/summary.csv (one row per case), <output>/case_<Ca>.csv (drag, tip position and the fluid under the
 // folded blade vs time), <output>/shape_<Ca>.csv (over the averaging window: the mean node positions from the base
 // and the mean force of the fluid on each node, N/m) and <output>/effective_length.png (plot.py).
@@ -100,6 +106,9 @@ struct Options {
   // A force-law sweep's inclined.csv: the flexible sweep's summary then adds the static reconfiguration under
   // that measured law (analysis/reconfiguration.hpp) beside Luhar & Nepf's.
   std::filesystem::path force_law;
+  // summary.csv of an earlier sweep with the same scene: its rigid blade is the reference, so a sweep can be split
+  // over several processes without running the rigid blade again
+  std::filesystem::path rigid_from;
   std::filesystem::path output = "out/blade_in_current";
 };
 
@@ -473,6 +482,9 @@ int main(int argc, char** argv) try {
   o.channel_width = cli.get_number("channel-width", o.channel_width, "--three-d: channel width W / b, [2, 50]");
   o.width_particles = static_cast<int>(cli.get_number(
       "width-particles", 0, "--three-d: particles across the strip's width (0: b / (rod spacing), at least 2)"));
+  o.rigid_from = cli.get("rigid-from", "",
+                         "summary.csv of an earlier sweep of the same scene: its rigid blade's drag is the reference "
+                         "(--cauchy then need not start with 0)");
   o.output = cli.get("output", o.output.string(), "output folder");
   if (!cli.finish()) return 0;
   require_positive("--speed (m/s)", o.speed);
@@ -504,13 +516,25 @@ int main(int argc, char** argv) try {
     if (o.three_d) throw InputError("--inclinations: the force-law sweep is 2D (leave out --three-d)");
     return run_force_law_sweep(o);
   }
-  if (o.cauchy.empty() || (o.end_time == 0 && o.cauchy.front() != 0))
-    throw InputError("--cauchy must start with 0 (the rigid blade that every l_e / l is measured against)");
+  if (o.cauchy.empty() || (o.end_time == 0 && o.rigid_from.empty() && o.cauchy.front() != 0))
+    throw InputError(
+        "--cauchy must start with 0 (the rigid blade that every l_e / l is measured against), or give --rigid-from");
   // The measured local law, read before the runs so that a bad file stops at once.
   std::optional<std::pair<analysis::TabulatedLoad<T>, analysis::TabulatedLoad<T>>> law;
   if (!o.force_law.empty()) law = read_force_law(o.force_law);
 
   std::vector<CaseResult> results;
+  if (!o.rigid_from.empty()) {  // the reference from an earlier sweep's rigid row
+    const auto table = io::read_csv(o.rigid_from);
+    const auto target = table.column("target_ca"), drag = table.column("drag"), error = table.column("drag_error");
+    const auto row = std::find(target.begin(), target.end(), T(0));
+    if (row == target.end())
+      throw InputError(fmt::format("--rigid-from {}: no rigid row (target_ca = 0)", o.rigid_from.string()));
+    const std::size_t k = std::size_t(row - target.begin());
+    const T nan = std::numeric_limits<T>::quiet_NaN();
+    results.push_back({0, nan, drag[k], error[k], 0, o.length, nan, 0, 0, nan, nan, 0, nan});
+    if (o.cauchy.front() == 0) o.cauchy.erase(o.cauchy.begin());
+  }
   for (const T ca : o.cauchy) {
     fmt::print("--- {}\n", ca > 0 ? fmt::format("Ca = {:g}", ca) : std::string("rigid blade"));
     try {

@@ -14,6 +14,14 @@ if(TARGET blade_in_current)
                    --coupling drag
                    --force-law ${CMAKE_CURRENT_BINARY_DIR}/blade_force_law/inclined.csv
                    --output ${CMAKE_CURRENT_BINARY_DIR}/blade_cauchy)
+  # The 3D strip (a ribbon, --three-d): rigid and flexible, 0.15 s each at l / dp = 6 with the background pressure
+  # and the visibility criterion in 3D; fails on a crash or a blow-up.
+  add_test(NAME blade_in_current.ribbon_3d
+           COMMAND blade_in_current --three-d on --resolution 6 --depth 2 --channel-width 3 --cauchy 0,100
+                   --end-time 0.15 --background-pressure 4 --contact-gap 0.5
+                   --output ${CMAKE_CURRENT_BINARY_DIR}/blade_ribbon_3d)
+  set_tests_properties(blade_in_current.ribbon_3d PROPERTIES LABELS "regression" TIMEOUT 120
+                       ENVIRONMENT "OMP_NUM_THREADS=1;OMP_WAIT_POLICY=passive")
   set_tests_properties(blade_in_current.force_law_sweep PROPERTIES FIXTURES_SETUP blade_force_law)
   set_tests_properties(blade_in_current.cauchy_sweep PROPERTIES FIXTURES_REQUIRED blade_force_law)
   set_tests_properties(blade_in_current.force_law_sweep blade_in_current.cauchy_sweep PROPERTIES LABELS "regression"

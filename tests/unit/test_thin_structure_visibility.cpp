@@ -407,4 +407,11 @@ TEST_CASE("visibility and guard in 3D: a ribbon hides pairs and stops steps thro
   CHECK(va.z() == 0.1);
   CHECK(p.position[p.slot_of_id(c)] == V3(0.001, 0.007, 0.05));
   CHECK(p.position[p.slot_of_id(e)].x() < 0);
+  // Bad input: a band wider than the support radius (the candidate search would miss pairs), an empty band.
+  ThinStructureVisibility<double, 3> wide;
+  std::vector<std::array<double, 2>> too_wide(edges.size(), {-0.01, 0.01});
+  wide.set_edges(edges, too_wide);
+  CHECK_THROWS_WITH(wide.update(system), Catch::Contains("lateral band 0.02 m wide"));
+  too_wide[3] = {0.002, 0.002};
+  CHECK_THROWS_WITH(wide.set_edges(edges, too_wide), Catch::Contains("edge 3 has the lateral band"));
 }

@@ -25,8 +25,9 @@
 // element, the segment between two particles of consecutive rows swept along y over its lateral band [lo, hi] (the
 // share of the width that particle stands for). A pair is blocked when its projection on the x-z plane crosses the
 // edge's segment (the 2D test above) at a point whose y, interpolated along the pair, lies in the band. The
-// candidate search is the same; with bands no wider than the rows' spacing the closer particle of a blocked pair is
-// within the support of one of the edge's two particles for the same edge lengths.
+// candidate search is the same, from the edge's two particles; the band is at most the particles' support radius wide
+// (checked), so that the crossing point lies within half a support laterally of them (a ribbon's bands are its rows'
+// spacing, a fraction of the support).
 #pragma once
 
 #include <sphfsi/core/error.hpp>
@@ -104,6 +105,11 @@ class ThinStructureVisibility {
             fmt::format("ThinStructureVisibility: edge {} is {:.4g} m long: valid range is up to "
                         "sqrt(3) x the nodes' support radius, {:.4g} m (refine the structure's nodes)",
                         k, double((to_[k] - from_[k]).norm()), double(std::sqrt(T(3)) * reach)));
+      if (Dim == 3 && !(bands_[k][1] - bands_[k][0] <= reach))
+        throw InputError(
+            fmt::format("ThinStructureVisibility: edge {} has a lateral band {:.4g} m wide: valid range is "
+                        "up to the nodes' support radius, {:.4g} m (more particles across the ribbon)",
+                        k, double(bands_[k][1] - bands_[k][0]), double(reach)));
       for (const std::size_t s : {s0, s1}) {
         system.for_each_neighbor(s, [&](std::size_t f, const SpaceVector&, T, T) {
           if (p.kind[f] == Kind::solid) return;
