@@ -116,6 +116,53 @@ struct ElasticRodParameters {
   }
 };
 
+namespace detail {
+/// A straight blade's nodes (2D) or rows (3D, `width_particles` across the width): see add_elastic_rod and
+/// add_elastic_ribbon. `who` names the caller in the error messages.
+template <class System>
+std::vector<std::uint32_t> add_straight_blade(System& system, const Vec<2, typename System::scalar_type>& base,
+                                              const Vec<2, typename System::scalar_type>& direction,
+                                              typename System::scalar_type length, int node_count, int width_particles,
+                                              typename System::scalar_type lateral_centre,
+                                              const ElasticMaterial<typename System::scalar_type>& material,
+                                              const RodSection<typename System::scalar_type>& section,
+                                              typename System::scalar_type smoothing_length, std::int32_t body,
+                                              const char* who) {
+  using T = typename System::scalar_type;
+  constexpr int Dim = System::dimension;
+  material.validate();
+  section.validate();
+  require_positive(fmt::format("{}: length (m)", who), length);
+  require_in_range(fmt::format("{}: node_count", who), node_count, 3, 1 << 24);
+  require_in_range(fmt::format("{}: width_particles", who), width_particles, 1, Dim == 2 ? 1 : 1 << 12);
+  require_positive(fmt::format("{}: smoothing_length (m)", who), smoothing_length);
+  require_positive(fmt::format("{}: |direction|", who), direction.norm());
+  require_finite(fmt::format("{}: lateral_centre (m)", who), lateral_centre);
+  for (int d = 0; d < 2; ++d) require_finite(fmt::format("{}: base (m)", who), base[d]);
+  const Vec<2, T> e = direction.normalized();
+  const T ds = length / T(node_count - 1), db = section.width / T(width_particles);
+  std::vector<std::uint32_t> ids;
+  auto& p = system.particles();
+  for (int i = 0; i < node_count; ++i) {
+    const T voronoi = (i == 0 || i == node_count - 1) ? T(0.5) * ds : ds;
+    const Vec<2, T> x = base + (T(i) * ds) * e;
+    for (int j = 0; j < width_particles; ++j) {
+      std::size_t slot;
+      if constexpr (Dim == 2) {  // masses per unit depth: rho t D_i
+        slot = p.add(Kind::solid, x, Vec<2, T>::Zero(), material.density,
+                     material.density * section.thickness * voronoi, smoothing_length, body);
+      } else {  // each particle stands for b / w of the width
+        const T y = lateral_centre + (T(j) + T(0.5) - T(0.5) * T(width_particles)) * db;
+        slot = p.add(Kind::solid, Vec<3, T>(x[0], y, x[1]), Vec<3, T>::Zero(), material.density,
+                     material.density * section.thickness * voronoi * db, smoothing_length, body);
+      }
+      ids.push_back(p.id[slot]);
+    }
+  }
+  return ids;
+}
+}  // namespace detail
+
 /// Adds a straight blade of `node_count` equally spaced nodes (Kind::solid, body `body`) from `base` along
 /// `direction` over `length` to the system, base first (increasing ids), with particle masses per unit depth
 /// rho t D_i and smoothing length `smoothing_length` (for the fluid's neighbour search). Returns their ids.
@@ -126,26 +173,9 @@ std::vector<std::uint32_t> add_elastic_rod(System& system, const Vec<2, typename
                                            const ElasticMaterial<typename System::scalar_type>& material,
                                            const RodSection<typename System::scalar_type>& section,
                                            typename System::scalar_type smoothing_length, std::int32_t body) {
-  using T = typename System::scalar_type;
-  static_assert(System::dimension == 2, "add_elastic_rod: the elastic rod is planar (2D systems only)");
-  material.validate();
-  section.validate();
-  require_positive("add_elastic_rod: length (m)", length);
-  require_in_range("add_elastic_rod: node_count", node_count, 3, 1 << 24);
-  require_positive("add_elastic_rod: smoothing_length (m)", smoothing_length);
-  require_positive("add_elastic_rod: |direction|", direction.norm());
-  for (int d = 0; d < 2; ++d) require_finite("add_elastic_rod: base (m)", base[d]);
-  const Vec<2, T> e = direction.normalized();
-  const T ds = length / T(node_count - 1);
-  std::vector<std::uint32_t> ids;
-  auto& p = system.particles();
-  for (int i = 0; i < node_count; ++i) {
-    const T voronoi = (i == 0 || i == node_count - 1) ? T(0.5) * ds : ds;
-    const std::size_t slot = p.add(Kind::solid, base + (T(i) * ds) * e, Vec<2, T>::Zero(), material.density,
-                                   material.density * section.thickness * voronoi, smoothing_length, body);
-    ids.push_back(p.id[slot]);
-  }
-  return ids;
+  static_assert(System::dimension == 2, "add_elastic_rod: the elastic rod is planar (add_elastic_ribbon in 3D)");
+  return detail::add_straight_blade(system, base, direction, length, node_count, 1, typename System::scalar_type(0),
+                                    material, section, smoothing_length, body, "add_elastic_rod");
 }
 
 /// Adds a straight ribbon to a 3D system (see the header comment): `node_count` equally spaced nodes from `base`
@@ -161,32 +191,9 @@ std::vector<std::uint32_t> add_elastic_ribbon(System& system, const Vec<2, typen
                                               const ElasticMaterial<typename System::scalar_type>& material,
                                               const RodSection<typename System::scalar_type>& section,
                                               typename System::scalar_type smoothing_length, std::int32_t body) {
-  using T = typename System::scalar_type;
   static_assert(System::dimension == 3, "add_elastic_ribbon: a ribbon needs a 3D system (add_elastic_rod in 2D)");
-  material.validate();
-  section.validate();
-  require_positive("add_elastic_ribbon: length (m)", length);
-  require_in_range("add_elastic_ribbon: node_count", node_count, 3, 1 << 24);
-  require_in_range("add_elastic_ribbon: width_particles", width_particles, 1, 1 << 12);
-  require_positive("add_elastic_ribbon: smoothing_length (m)", smoothing_length);
-  require_positive("add_elastic_ribbon: |direction|", direction.norm());
-  require_finite("add_elastic_ribbon: lateral_centre (m)", lateral_centre);
-  for (int d = 0; d < 2; ++d) require_finite("add_elastic_ribbon: base (m)", base[d]);
-  const Vec<2, T> e = direction.normalized();
-  const T ds = length / T(node_count - 1), db = section.width / T(width_particles);
-  std::vector<std::uint32_t> ids;
-  auto& p = system.particles();
-  for (int i = 0; i < node_count; ++i) {
-    const T voronoi = (i == 0 || i == node_count - 1) ? T(0.5) * ds : ds;
-    const Vec<2, T> x = base + (T(i) * ds) * e;
-    for (int j = 0; j < width_particles; ++j) {
-      const T y = lateral_centre + (T(j) + T(0.5) - T(0.5) * T(width_particles)) * db;
-      const std::size_t slot = p.add(Kind::solid, Vec<3, T>(x[0], y, x[1]), Vec<3, T>::Zero(), material.density,
-                                     material.density * section.thickness * voronoi * db, smoothing_length, body);
-      ids.push_back(p.id[slot]);
-    }
-  }
-  return ids;
+  return detail::add_straight_blade(system, base, direction, length, node_count, width_particles, lateral_centre,
+                                    material, section, smoothing_length, body, "add_elastic_ribbon");
 }
 
 /// Planar discrete elastic rod owning the solid particles of one body (a ParticleModel and a SolidModel); in a 3D
