@@ -76,6 +76,9 @@ struct Options {
   bool visibility = true;  // fluid pairs across the blade do not interact (fluid/thin_structure_visibility.hpp)
   bool guard = true;       // fluid that steps through the blade is put back (fluid/thin_structure_guard.hpp)
   T contact_gap = 2;       // resolved blade: height of its contact plane above the bed, in fluid spacings
+  // Resolved blade: its structure continues this far into the bed (fluid spacings), clamped there, so that the
+  // visibility criterion also parts the bed's wall particles under its two faces (0: the blade ends at the bed)
+  T anchor = 0;
   // repulsive: the blade is resolved as an obstacle (eqs 17-23) | drag: porous, it exchanges its Morison drag with
   // the fluid (coupling/blade_drag.hpp), the drag law of Luhar & Nepf's model itself: a check of the rod and of the
   // fluid's response, not of the flow around the blade
@@ -217,6 +220,10 @@ CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
   // The blade on a lattice line (fluid columns at dp/2 on either side), nodes every rod_spacing dp (dp/2); in 3D
   // each node a row across the strip's width at about the same spacing.
   const int nodes = static_cast<int>(std::lround(o.particles_along / o.rod_spacing)) + 1;
+  // nodes buried in the bed below the base (--anchor), on the same spacing: the node at the bed stays a node
+  const int buried = inclination == 0 && mount[1] == 0 ? static_cast<int>(std::lround(o.anchor / o.rod_spacing)) : 0;
+  const T buried_length = T(buried) * l / T(nodes - 1);
+  const V root = mount - buried_length * direction;
   ElasticMaterial<T> material;
   material.density = o.density;
   material.poisson_ratio = T(0.4);
@@ -225,12 +232,13 @@ CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
       target_ca > 0 ? rho * o.nominal_drag * U * U * l * l * l / (2 * target_ca * second_moment) : T(1e9);
   const RodSection<T> section{.thickness = o.thickness, .width = o.blade_width};
   if constexpr (Dim == 2) {
-    add_elastic_rod(system, mount, direction, l, nodes, material, section, res.h(), 1);
+    add_elastic_rod(system, root, direction, l + buried_length, nodes + buried, material, section, res.h(), 1);
   } else {
     const int rows = o.width_particles > 0
                          ? o.width_particles
                          : std::max(2, static_cast<int>(std::lround(o.blade_width / (o.rod_spacing * dp))));
-    add_elastic_ribbon(system, mount, direction, l, nodes, rows, T(0), material, section, res.h(), 1);
+    add_elastic_ribbon(system, root, direction, l + buried_length, nodes + buried, rows, T(0), material, section,
+                       res.h(), 1);
   }
   typename RodD::Parameters params;
   params.section = section;
@@ -248,7 +256,8 @@ CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
   // 0.92 s); 2 dp holds. A porous blade traps no fluid: its contact plane is the bed itself (a gap g would hold its
   // lowest g upright).
   rod.set_contact_plane(V(0, 0), V(0, 1), porous ? T(0) : o.contact_gap * dp);
-  if (target_ca > 0) rod.clamp_base();
+  if (target_ca > 0 && buried == 0) rod.clamp_base();
+  else if (target_ca > 0) rod.clamp_where([&](const VD& x) { return x[Dim - 1] <= T(1e-9) * dp; });  // and buried
   else rod.clamp_where([](const VD&) { return true; });  // the rigid reference blade
   // Towing: velocity U (1 - cos(pi t / ramp)) / 2 during the ramp, U after it.
   const T pi = std::numbers::pi_v<T>;
@@ -313,7 +322,7 @@ CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
     const VD force = s.template model<0>().solid().coupling_force(p);
     const T drag = -force[0], lift = force[Dim - 1];
     const auto& x = s.template model<0>().solid().positions();
-    const V base = x.front(), tip = x.back();
+    const V base = x[std::size_t(buried)], tip = x.back();
     T under = std::numeric_limits<T>::quiet_NaN();  // 2D: the fluid a folded full-width blade seals off
     if constexpr (Dim == 2) under = porous ? T(0) : fluid_under_blade(p, ids, dp) / (l * l);
     csv.write_row({s.time(), drag, lift, tip[0] - base[0], tip[1] - base[1], under});
@@ -446,6 +455,11 @@ int main(int argc, char** argv) try {
                      "resolved blade: its contact plane's height above the bed, in fluid spacings, [0.5, 10] "
                      "(session 4-7 runs: 1)");
   require_in_range("--contact-gap", o.contact_gap, T(0.5), T(10));
+  o.anchor = cli.get_number("anchor", 0,
+                            "resolved blade: its structure continues this far into the bed, in fluid spacings, "
+                            "clamped, so that the visibility criterion parts the wall under its two faces "
+                            "(0: none), [0, 3]");
+  require_in_range("--anchor (fluid spacings)", o.anchor, T(0), T(3));
   o.global_step =
       cli.get_switch("global-step", false,
                      "on: the fluid steps with the rod's stable step (no sub-cycling; for the cost comparison) | off");
