@@ -51,4 +51,11 @@ concept SpatialDimension = (Dim == 2 || Dim == 3);
 /// edges, the fluid hides particle pairs across them (fluid/thin_structure_visibility.hpp).
 using StructureEdge = std::array<std::uint32_t, 2>;
 
+/// The (x, vertical) components of a point: the plane a blade bends in (in 3D, a ribbon: solid/elastic_rod.hpp).
+template <int Dim, class T>
+Vec<2, T> bending_plane(const Vec<Dim, T>& x) {
+  if constexpr (Dim == 2) return x;
+  else return Vec<2, T>(x[0], x[Dim - 1]);
+}
+
 }  // namespace sphfsi

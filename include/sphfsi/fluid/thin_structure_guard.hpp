@@ -154,7 +154,7 @@ class ThinStructureGuard {
     });
     return edge;
   }
-  static Vector plane(const Vec<Dim, T>& x) { return Visibility::in_plane(x); }
+  static Vector plane(const Vec<Dim, T>& x) { return bending_plane(x); }
   static void add_in_plane(Vec<Dim, T>& x, const Vector& d) {
     x[0] += d[0];
     x[Dim - 1] += d[1];

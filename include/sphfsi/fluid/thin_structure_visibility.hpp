@@ -95,8 +95,8 @@ class ThinStructureVisibility {
                           k, edges_[k][end]));
       }
       const std::size_t s0 = p.slot_of_id(edges_[k][0]), s1 = p.slot_of_id(edges_[k][1]);
-      from_[k] = in_plane(p.position[s0]);
-      to_[k] = in_plane(p.position[s1]);
+      from_[k] = bending_plane(p.position[s0]);
+      to_[k] = bending_plane(p.position[s1]);
       // The candidate search finds every hidden pair only for edges up to sqrt(3) x the nodes' support radius.
       const T reach =
           support_radius<typename System::kernel_type>(std::min(p.smoothing_length[s0], p.smoothing_length[s1]));
@@ -143,12 +143,6 @@ class ThinStructureVisibility {
     return crosses_any(head_[a], xa, xb) || crosses_any(head_[b], xa, xb);
   }
 
-  /// (x, z) of a point in space: the plane the structures bend in.
-  static Vector in_plane(const SpaceVector& x) noexcept {
-    if constexpr (Dim == 2) return x;
-    else return Vector(x[0], x[2]);
-  }
-
   /// Whether the pair segment p0 p1 crosses the edge q0 q1: p0, p1 strictly on opposite sides of the edge's line,
   /// q0, q1 on opposite sides of the pair's line with q0 on it counted as below and q1 on it as above (half-open:
   /// a chain of edges through a point of the pair's line is crossed once).
@@ -166,7 +160,7 @@ class ThinStructureVisibility {
     std::int32_t edge, next;
   };
   bool crosses_any(std::int32_t e, const SpaceVector& xa, const SpaceVector& xb) const noexcept {
-    const Vector pa = in_plane(xa), pb = in_plane(xb);
+    const Vector pa = bending_plane(xa), pb = bending_plane(xb);
     for (; e >= 0; e = entries_[e].next) {
       const std::int32_t k = entries_[e].edge;
       if (!segments_cross(pa, pb, from_[k], to_[k])) continue;

@@ -431,7 +431,7 @@ class BladeCrossingCounter {
         if constexpr (Dim == 3) {
           if (p.position[f][1] < strip.first || p.position[f][1] > strip.second) continue;
         }
-        const Vector y = in_plane(p.position[f]);
+        const Vector y = bending_plane(p.position[f]);
         if (y[0] < lo[0] || y[0] > hi[0] || y[1] < lo[1] || y[1] > hi[1]) continue;
         now.emplace(p.id[f], y);
         const auto it = near_[b].find(p.id[f]);
@@ -451,10 +451,6 @@ class BladeCrossingCounter {
   std::size_t total() const noexcept { return total_; }
 
  private:
-  static Vector in_plane(const Vec<Dim, T>& x) {
-    if constexpr (Dim == 2) return x;
-    else return Vector(x[0], x[2]);
-  }
   T reach_;
   std::vector<std::vector<Vector>> nodes_;                       // per blade: node positions at the last call
   std::vector<std::unordered_map<std::uint32_t, Vector>> near_;  // per blade: fluid near it at the last call, by id

@@ -223,8 +223,8 @@ class ElasticRod {
       if (p.kind[i] == Kind::solid && p.body[i] == body) ids_.push_back(p.id[i]);
     std::sort(ids_.begin(), ids_.end());
     if constexpr (Dim == 3) {  // the row of the first node: the leading particles at its (x, z)
-      while (per_node_ < ids_.size() &&
-             in_plane(p.position[p.slot_of_id(ids_[per_node_])]) == in_plane(p.position[p.slot_of_id(ids_[0])]))
+      while (per_node_ < ids_.size() && bending_plane(p.position[p.slot_of_id(ids_[per_node_])]) ==
+                                            bending_plane(p.position[p.slot_of_id(ids_[0])]))
         ++per_node_;
     }
     if (ids_.size() % per_node_ != 0)
@@ -246,15 +246,15 @@ class ElasticRod {
       const std::size_t k = i / per_node_, s = p.slot_of_id(ids_[i]);
       local_of_id_[ids_[i]] = static_cast<std::int64_t>(k);
       if (i % per_node_ == 0) {
-        x_[k] = in_plane(p.position[s]);
-        v_[k] = in_plane(p.velocity[s]);
-      } else if (in_plane(p.position[s]) != x_[k]) {
+        x_[k] = bending_plane(p.position[s]);
+        v_[k] = bending_plane(p.velocity[s]);
+      } else if (bending_plane(p.position[s]) != x_[k]) {
         throw InputError(
             fmt::format("ElasticRod: particle id {} of body {} is not at the (x, z) of its row's first "
                         "particle (rows of {} across the width; valid: add_elastic_ribbon)",
                         ids_[i], body, per_node_));
       }
-      if (Dim == 3 && (in_plane(p.velocity[s]) != v_[k] || p.velocity[s][Dim - 2] != T(0)))
+      if (Dim == 3 && (bending_plane(p.velocity[s]) != v_[k] || p.velocity[s][Dim - 2] != T(0)))
         throw InputError(
             fmt::format("ElasticRod: particle id {} of body {} does not move with its row (valid: the "
                         "row's particles share one velocity in the x-z plane, zero along y)",
@@ -588,11 +588,7 @@ class ElasticRod {
     return std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b));
   }
   static Vector perp(const Vector& e) { return Vector(-e.y(), e.x()); }
-  /// (x, z) of a point in space, and the point of the rod's plane at lateral position y.
-  static Vector in_plane(const SpaceVector& x) {
-    if constexpr (Dim == 2) return x;
-    else return Vector(x[0], x[2]);
-  }
+  /// The point of the rod's plane at lateral position y (bending_plane, core/types.hpp, is the inverse).
   static SpaceVector in_space(const Vector& x, T lateral) {
     if constexpr (Dim == 2) return x;
     else return SpaceVector(x[0], lateral, x[1]);
@@ -658,19 +654,19 @@ class ElasticRod {
   void gather(const ParticleSet<Dim, T>& p, bool external) {
     for (std::size_t k = 0; k < node_count(); ++k) {
       const std::size_t s = p.slot_of_id(ids_[k * per_node_]);
-      x_[k] = in_plane(p.position[s]);
-      v_[k] = in_plane(p.velocity[s]);
+      x_[k] = bending_plane(p.position[s]);
+      v_[k] = bending_plane(p.velocity[s]);
       if (!external) continue;
       if (held_[k]) {
         a_ext_[k] = Vector::Zero();
       } else if (per_node_ == 1) {
-        a_ext_[k] = in_plane(p.acceleration[s]);
+        a_ext_[k] = bending_plane(p.acceleration[s]);
       } else {
         Vector force = Vector::Zero();
         T mass = T(0);
         for (std::size_t j = 0; j < per_node_; ++j) {
           const std::size_t r = p.slot_of_id(ids_[k * per_node_ + j]);
-          force += p.mass[r] * in_plane(p.acceleration[r]);
+          force += p.mass[r] * bending_plane(p.acceleration[r]);
           mass += p.mass[r];
         }
         a_ext_[k] = force / mass;
