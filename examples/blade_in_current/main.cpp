@@ -95,6 +95,9 @@ struct Options {
   // pressure the wake's suction pulls the fluid off the lee face (g = 0: no hydrostatic pressure, unlike the flume).
   T background_pressure = 0;
   T depth_lengths = 3;  // channel depth in blade lengths (blockage l / depth)
+  // The bed, walls and lid: dynamic boundary particles, or their pressure extrapolated from the fluid (Adami et al.
+  // 2012): a dynamic bed that the towed blade has passed keeps the blade's stagnation pressure (session 32)
+  WallModel walls = WallModel::dynamic;
   // 3D: a strip of width b (a ribbon) in the middle of a channel of width W, so that the water can pass the blade's
   // sides as round Luhar & Nepf's blades (b / l = 0.2), instead of the 2D full-width blade
   bool three_d = false;
@@ -269,6 +272,7 @@ CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
   FluidParameters<Dim, T> fluid;
   fluid.gravity = VD::Zero();
   fluid.artificial_viscosity = o.artificial_viscosity;
+  fluid.walls = o.walls;
   fluid.thin_structure_visibility = o.visibility && !porous;  // the fluid passes a porous blade
   fluid.thin_structure_guard = o.guard;
   fluid.background_pressure = o.background_pressure * rho * U * U;
@@ -301,6 +305,17 @@ CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
   // node positions relative to the base and the couplings' force on each node (its row in 3D), summed over the
   // averaging window
   std::vector<V> mean_shape(node_count, V::Zero()), mean_load(node_count, V::Zero());
+  // The mean flow around the blade's base in the blade's frame over the averaging window: bins of dp / 4 from -l / 2
+  // to l / 2 along the tow and from 2 dp under the bed to l / 2 above it (3D: the strip's own width only), each with
+  // the particles' summed pressure, velocity relative to the blade and count (wall particles below the bed).
+  const T bin = dp / 4, field_x0 = -l / 2, field_z0 = -2 * dp;
+  const auto bins_x = static_cast<std::size_t>(std::lround(l / bin)),
+             bins_z = static_cast<std::size_t>(std::lround((l / 2 + 2 * dp) / bin));
+  struct FieldBin {
+    T pressure = 0, u = 0, w = 0, count = 0;
+  };
+  std::vector<FieldBin> base_field(bins_x * bins_z);
+  std::size_t field_samples = 0;
   T tip_x = 0, tip_y = 0, tip_y_squared = 0, under_sum = 0;
   std::size_t tip_n = 0;
   io::ProgressReporter progress(t_end);
@@ -340,6 +355,20 @@ CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
       }
       under_sum += under;
       ++tip_n;
+      for (std::size_t f = 0; f < p.size(); ++f) {
+        if (p.kind[f] == Kind::solid) continue;
+        if constexpr (Dim == 3)
+          if (std::abs(p.position[f][1]) > o.blade_width / 2) continue;
+        const T bx = (p.position[f][0] - base[0] - field_x0) / bin,
+                bz = (p.position[f][Dim - 1] - base[1] - field_z0) / bin;
+        if (bx < 0 || bz < 0 || bx >= T(bins_x) || bz >= T(bins_z)) continue;
+        FieldBin& c = base_field[std::size_t(bz) * bins_x + std::size_t(bx)];
+        c.pressure += p.pressure[f];
+        c.u += p.velocity[f][0] - U;
+        c.w += p.velocity[f][Dim - 1];
+        c.count += 1;
+      }
+      ++field_samples;
     }
   });
   progress.finish(sim);
@@ -354,6 +383,14 @@ CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
     io::CsvWriter shape(o.output / fmt::format("shape_{}.csv", label), {"node", "dx", "dy", "force_x", "force_y"});
     for (std::size_t k = 0; k < node_count; ++k)
       shape.write_row({T(k), mean_shape[k][0] / n, mean_shape[k][1] / n, mean_load[k][0] / n, mean_load[k][1] / n});
+    io::CsvWriter field(o.output / fmt::format("base_field_{}.csv", label),
+                        {"x", "z", "pressure", "u", "w", "occupancy"});
+    for (std::size_t k = 0; k < base_field.size(); ++k) {
+      const FieldBin& c = base_field[k];
+      const T x = field_x0 + (T(k % bins_x) + T(0.5)) * bin, z = field_z0 + (T(k / bins_x) + T(0.5)) * bin;
+      const T nan = std::numeric_limits<T>::quiet_NaN(), per = c.count > 0 ? 1 / c.count : nan;
+      field.write_row({x, z, c.pressure * per, c.u * per, c.w * per, c.count / T(field_samples)});
+    }
   }
   return {target_ca,     material.youngs_modulus,
           mean,          se,
@@ -474,6 +511,12 @@ int main(int argc, char** argv) try {
       "resolved blade: the fluid's background pressure over rho U^2, which holds the fluid on the blade's "
       "lee face in the wake's suction (0: none), [0, 100]");
   require_in_range("--background-pressure (rho U^2)", o.background_pressure, T(0), T(100));
+  const std::string walls = cli.get("walls", "dynamic",
+                                    "wall model of the bed, side walls and lid: dynamic (boundary particles with their "
+                                    "own continuity) | extrapolated (pressure from the fluid, Adami et al. 2012)");
+  if (walls != "dynamic" && walls != "extrapolated")
+    throw InputError(fmt::format("--walls '{}': valid are dynamic, extrapolated", walls));
+  o.walls = walls == "dynamic" ? WallModel::dynamic : WallModel::extrapolated;
   o.end_time = cli.get_number("end-time", 0, "simulated time, s (0: the ramp and the whole towing distance)");
   require_non_negative("--end-time (s)", o.end_time);
   o.depth_lengths = cli.get_number("depth", o.depth_lengths, "channel depth in blade lengths (blockage 1 / depth)");

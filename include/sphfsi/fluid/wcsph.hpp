@@ -27,6 +27,14 @@
 //   dynamic boundary particles (Crespo, Gomez-Gesteira & Dalrymple 2007, CMC 5:173; the SPHysics default):
 //     wall particles obey the continuity equation with their fluid neighbours and enter the fluid's
 //     pressure and viscosity sums; their density is kept >= rho0 so walls never attract fluid.
+//   extrapolated walls (Adami, Hu & Adams 2012, J. Comput. Phys. 231:7057, eq. 27): the same wall particles in the
+//   same sums, but at every evaluation each takes the pressure of the fluid it sees, extrapolated to its place,
+//     p_w = (sum_f p_f W_wf + (g - a_w) . sum_f rho_f (x_w - x_f) W_wf) / sum_f W_wf,
+//   and the density rho_w = rho(p_w) of the equation of state. A dynamic wall particle carries the density its own
+//   continuity equation gave it, which lags: a bed that a towed blade has passed keeps the blade's stagnation
+//   pressure (docs/thin-blades.md, session 32). Here a_w = 0: walls at rest or moving steadily (an accelerating
+//   wavemaker keeps dynamic walls). Pairs hidden by a thin structure are left out of the sums, so a wall particle
+//   under a blade's face takes that face's pressure. p_w + p_bg >= 0: a wall never pulls the fluid.
 //   repulsive walls (Monaghan & Kos 1999, with Rogers & Dalrymple 2008): see boundary/repulsive_force.hpp;
 //     wall particles only push the fluid along their normal and take no part in the SPH sums.
 // Thin structures (one line of nodes, e.g. solid/elastic_rod.hpp) publish their edges (Simulation collects them from
@@ -62,6 +70,9 @@ namespace sphfsi {
 enum class WallModel {
   dynamic,    ///< dynamic boundary particles (SPHysics default)
   repulsive,  ///< Monaghan-Kos repulsive force
+  /// Wall particles whose pressure is extrapolated from the fluid beside them at every evaluation (Adami, Hu & Adams
+  /// 2012): no density of their own to lag behind the fluid's
+  extrapolated,
 };
 
 /// Which fluid particles get the kernel-gradient-corrected pressure gradient (Bonet & Lok 1999; see the header).
@@ -221,10 +232,11 @@ class WcsphFluid {
       p.density_rate[a] = T(0);
       p.xsph_velocity[a] = Vector::Zero();
     });
-    if (params_.gradient_correction != GradientCorrection::none) update_gradient_correction(system);
     occluded_ = params_.thin_structure_visibility && visibility_.active();
     guarded_ = params_.thin_structure_guard && visibility_.active();
     if (occluded_ || guarded_) visibility_.update(system);  // the guard uses the same candidate edges
+    if (params_.walls == WallModel::extrapolated) extrapolate_wall_pressure(system);
+    if (params_.gradient_correction != GradientCorrection::none) update_gradient_correction(system);
     // A few slot ranges per thread, handed out dynamically: wall particles cost less than fluid ones, and on a
     // shared machine a thread may be descheduled for a while.
     const std::size_t threads = static_cast<std::size_t>(std::max(1, thread_count()));
@@ -313,7 +325,7 @@ class WcsphFluid {
     const auto& p = system.particles();
     const std::size_t n = p.size();
     correction_.resize(n);
-    const bool dynamic_walls = params_.walls == WallModel::dynamic;
+    const bool dynamic_walls = params_.walls != WallModel::repulsive;  // walls in the pressure sums
     const bool everywhere = params_.gradient_correction == GradientCorrection::everywhere;
     // Candidates: every fluid particle, or those within the support of a repulsive wall particle (found from the
     // wall side: walls are few).
@@ -374,6 +386,44 @@ class WcsphFluid {
         return;
       correction_[a] = moment.inverse();
       corrected_[a] = 1;
+    });
+  }
+
+  // Extrapolated walls (see the header): each wall particle's pressure, density, sound speed, p / rho^2 and volume
+  // from the fluid it sees. Reads fluid slots only and writes wall slots only, so the wall particles run in parallel.
+  // A frozen wall particle (local time stepping) keeps its values; with same_resolution_pairs a wall particle sees
+  // the fluid of its own size.
+  void extrapolate_wall_pressure(System& system) {
+    auto& p = system.particles();
+    const auto& kernel = system.kernel();
+    const auto& eos = system.eos();
+    const Vector g = params_.gravity;
+    const T background = params_.background_pressure;
+    const bool same_resolution = params_.same_resolution_pairs;
+    parallel_for(p.size(), [&](std::size_t w) {
+      if (p.kind[w] != Kind::wall || (frozen_ && frozen_[w])) return;
+      const T h_w = p.smoothing_length[w];
+      const Vector x_w = p.position[w];
+      T weight = T(0), pressure_sum = T(0);
+      Vector density_moment = Vector::Zero();  // sum_f rho_f (x_w - x_f) W_wf
+      system.for_each_neighbor(w, [&](std::size_t f, const Vector& dx, T r, T h) {
+        if (p.kind[f] != Kind::fluid) return;
+        if (same_resolution && std::abs(p.smoothing_length[f] - h_w) > same_h_tolerance * h_w) return;
+        if (occluded_ && (visibility_.near(w) || visibility_.near(f)) && visibility_.blocks(w, f, x_w, p.position[f]))
+          return;
+        const T w_wf = kernel.value(r, h);
+        weight += w_wf;
+        pressure_sum += p.pressure[f] * w_wf;
+        density_moment += (p.density[f] * w_wf) * dx;
+      });
+      // eq. 27 with a_w = 0; a wall particle out of every fluid particle's reach keeps the reference state
+      const T pressure = std::max(weight > T(0) ? (pressure_sum + g.dot(density_moment)) / weight : T(0), -background);
+      const T density = eos.density(pressure);
+      p.pressure[w] = pressure;
+      p.density[w] = density;
+      p.sound_speed[w] = eos.sound_speed(density);
+      pressure_term_[w] = (pressure + background) / (density * density);
+      volume_[w] = p.mass[w] / density;
     });
   }
 
@@ -455,7 +505,7 @@ class WcsphFluid {
     const T delta = params_.density_diffusion;
     const T eps_xsph = params_.xsph;
     const T nu = params_.kinematic_viscosity;
-    const bool dynamic_walls = params_.walls == WallModel::dynamic;
+    const bool dynamic_walls = params_.walls != WallModel::repulsive;  // walls in the pressure sums
     const bool corrected = params_.gradient_correction != GradientCorrection::none;
     const bool difference_form = params_.gradient_correction == GradientCorrection::resolution_jumps;
     const T* pressure = p.pressure.data();

@@ -99,7 +99,7 @@ std::size_t add_box_walls(System& system, const Vec<System::dimension, typename 
   const T mass = rho0 * std::pow(res.dp, T(Dim));
   std::size_t added = 0;
   const T tol = T(1e-6) * res.dp;
-  if (model == WallModel::dynamic) {
+  if (model != WallModel::repulsive) {  // dynamic or extrapolated: layers of wall particles on the lattice
     V lo = inner_lower, hi = inner_upper;
     for (int d = 0; d < Dim; ++d) {
       lo[d] -= T(layers) * res.dp;
