@@ -70,8 +70,9 @@ std::size_t add_fluid_block(System& system, const Vec<System::dimension, typenam
 
 /// Walls around the box [inner_lower, inner_upper] (open at the top). Returns the particle count.
 ///
-/// Dynamic walls (Crespo et al. 2007): `layers` rows of particles outside the box at (k + 1/2) dp from its faces,
-/// so the fluid (whose first row sits dp/2 inside a face) sees a full kernel support of wall particles.
+/// Dynamic walls (Crespo et al. 2007) and extrapolated walls (Adami et al. 2012): `layers` rows of particles outside
+/// the box at (k + 1/2) dp from its faces, so the fluid (whose first row sits dp/2 inside a face) sees a full kernel
+/// support of wall particles.
 ///
 /// Repulsive walls (Monaghan & Kos 1999; Rogers & Dalrymple 2008): one row of boundary particles ON each face,
 /// each carrying that face's unit normal (into the box); `layers` is ignored. Every face is a complete row of its
