@@ -47,7 +47,7 @@ def main():
     if len(sys.argv) < 4:
         sys.exit(__doc__)
     png, dp = sys.argv[1], float(sys.argv[2])
-    runs = [a.split("=", 1) for a in sys.argv[3:]]
+    runs = [a.rsplit("=", 1) for a in sys.argv[3:]]
     fig, axes = plt.subplots(len(runs), 2, figsize=(10, 3.6 * len(runs)), squeeze=False)
     fields = [merged(path, dp) for _, path in runs]
     finite = np.concatenate([f[2][np.isfinite(f[2])] for f in fields])

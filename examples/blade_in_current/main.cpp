@@ -109,6 +109,10 @@ struct Options {
   // The force-law sweep: rigid blades inclined by these angles from the vertical (degrees, leaning downstream).
   std::vector<T> inclinations;
   T mount_height = 0;  // force-law sweep: the rigid blades' base above the bed, blade lengths (0: on the bed)
+  // A double blade of length l clamped at its middle, away from the bed (its lower end at mount_height): each half is
+  // the mirror image of the other, so each is a blade of length l / 2 standing on a free-slip plane, without a bed
+  // and its wall particles (the Cauchy number is set for the half)
+  bool clamp_middle = false;
   // A force-law sweep's inclined.csv: the flexible sweep's summary then adds the static reconfiguration under
   // that measured law (analysis/reconfiguration.hpp) beside Luhar & Nepf's.
   std::filesystem::path force_law;
@@ -203,7 +207,8 @@ CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
   // The blade leans downstream of the towing (towards -x) by `inclination`. Upright, it lies on a lattice line with
   // the fluid columns dp/2 on either side; inclined, the fluid within dp/2 of it is taken out.
   const V direction(-std::sin(inclination), std::cos(inclination));
-  const V mount(x0, target_ca > 0 ? T(0) : std::round(o.mount_height * l / dp) * dp);  // the blade's base
+  const V mount(
+      x0, target_ca > 0 && !o.clamp_middle ? T(0) : std::round(o.mount_height * l / dp) * dp);  // the blade's base
   if constexpr (Dim == 2) {
     if (inclination != 0) {
       auto& p = system.particles();
@@ -231,8 +236,10 @@ CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
   material.density = o.density;
   material.poisson_ratio = T(0.4);
   const T second_moment = o.thickness * o.thickness * o.thickness / 12;  // per unit width, m^3
+  const T bending_length = o.clamp_middle ? l / 2 : l;                   // the length that bends from a clamp
   material.youngs_modulus =
-      target_ca > 0 ? rho * o.nominal_drag * U * U * l * l * l / (2 * target_ca * second_moment) : T(1e9);
+      target_ca > 0 ? rho * o.nominal_drag * U * U * std::pow(bending_length, T(3)) / (2 * target_ca * second_moment)
+                    : T(1e9);
   const RodSection<T> section{.thickness = o.thickness, .width = o.blade_width};
   if constexpr (Dim == 2) {
     add_elastic_rod(system, root, direction, l + buried_length, nodes + buried, material, section, res.h(), 1);
@@ -259,7 +266,10 @@ CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
   // 0.92 s); 2 dp holds. A porous blade traps no fluid: its contact plane is the bed itself (a gap g would hold its
   // lowest g upright).
   rod.set_contact_plane(V(0, 0), V(0, 1), porous ? T(0) : o.contact_gap * dp);
-  if (target_ca > 0 && buried == 0) rod.clamp_base();
+  const T node_spacing = l / T(nodes - 1), middle = mount[1] + l / 2;
+  if (target_ca > 0 && o.clamp_middle)  // the middle node and its two neighbours: both halves clamped there
+    rod.clamp_where([&](const VD& x) { return std::abs(x[Dim - 1] - middle) <= T(1.01) * node_spacing; });
+  else if (target_ca > 0 && buried == 0) rod.clamp_base();
   else if (target_ca > 0) rod.clamp_where([&](const VD& x) { return x[Dim - 1] <= T(1e-9) * dp; });  // and buried
   else rod.clamp_where([](const VD&) { return true; });  // the rigid reference blade
   // Towing: velocity U (1 - cos(pi t / ramp)) / 2 during the ramp, U after it.
@@ -337,7 +347,8 @@ CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
     const VD force = s.template model<0>().solid().coupling_force(p);
     const T drag = -force[0], lift = force[Dim - 1];
     const auto& x = s.template model<0>().solid().positions();
-    const V base = x[std::size_t(buried)], tip = x.back();
+    // the base: the node at the bed, or the double blade's middle (its upper half is then the blade reported)
+    const V base = x[o.clamp_middle ? (node_count - 1) / 2 : std::size_t(buried)], tip = x.back();
     T under = std::numeric_limits<T>::quiet_NaN();  // 2D: the fluid a folded full-width blade seals off
     if constexpr (Dim == 2) under = porous ? T(0) : fluid_under_blade(p, ids, dp) / (l * l);
     csv.write_row({s.time(), drag, lift, tip[0] - base[0], tip[1] - base[1], under});
@@ -529,6 +540,11 @@ int main(int argc, char** argv) try {
   o.mount_height = cli.get_number("mount-height", 0,
                                   "force-law sweep: the rigid blades' base above the bed, blade lengths (0: on the "
                                   "bed; > 0: a plate in open water, away from the bed)");
+  o.clamp_middle = cli.get_switch(
+      "clamp-middle", false,
+      "on: a double blade of length --length clamped at its middle, its lower end --mount-height above the bed: each "
+      "half mirrors the other, a blade of half the length on a free-slip plane without the bed's wall particles "
+      "(Ca for the half) | off");
   o.force_law = cli.get("force-law", "",
                         "inclined.csv of a force-law sweep: the static reconfiguration under that measured local law "
                         "is added to the Cauchy sweep's summary (column model_2d)");
@@ -558,6 +574,9 @@ int main(int argc, char** argv) try {
   require_positive("--blade-width (m)", o.blade_width);
   require_in_range("--channel-width (W / b)", o.channel_width, T(2), T(50));
   require_in_range("--width-particles", o.width_particles, 0, 64);
+  if (o.clamp_middle && !(o.mount_height > 0))
+    throw InputError("--clamp-middle: the double blade needs --mount-height > 0 (its lower end above the bed)");
+  require_in_range("--mount-height (blade lengths)", o.mount_height, T(0), o.depth_lengths - T(1));
   if (o.three_d && o.coupling != "repulsive")
     throw InputError("--three-d: the strip is coupled by --coupling repulsive only (the drag blade is 2D)");
   const auto parse_list = [](const std::string& text) {
