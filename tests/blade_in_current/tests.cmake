@@ -20,6 +20,14 @@ if(TARGET blade_in_current)
            COMMAND blade_in_current --three-d on --resolution 6 --depth 2 --channel-width 3 --cauchy 0,100
                    --end-time 0.15 --background-pressure 4 --contact-gap 0.5
                    --output ${CMAKE_CURRENT_BINARY_DIR}/blade_ribbon_3d)
+  # The double blade clamped at its middle (--clamp-middle, a blade on a free-slip plane) on extrapolated walls
+  # (--walls extrapolated): rigid and flexible, 0.15 s at l / dp = 8 per half; fails on a crash or a blow-up.
+  add_test(NAME blade_in_current.double_blade_extrapolated_walls
+           COMMAND blade_in_current --resolution 16 --length 0.1 --depth 3 --mount-height 1 --clamp-middle on
+                   --walls extrapolated --cauchy 0,100 --end-time 0.15 --background-pressure 4 --contact-gap 0.5
+                   --output ${CMAKE_CURRENT_BINARY_DIR}/blade_double_extrapolated)
+  set_tests_properties(blade_in_current.double_blade_extrapolated_walls PROPERTIES LABELS "regression" TIMEOUT 120
+                       ENVIRONMENT "OMP_NUM_THREADS=1;OMP_WAIT_POLICY=passive")
   set_tests_properties(blade_in_current.ribbon_3d PROPERTIES LABELS "regression" TIMEOUT 120
                        ENVIRONMENT "OMP_NUM_THREADS=1;OMP_WAIT_POLICY=passive")
   set_tests_properties(blade_in_current.force_law_sweep PROPERTIES FIXTURES_SETUP blade_force_law)
