@@ -271,6 +271,7 @@ TEST_CASE("background pressure: no force in a full support; repulsive walls hold
 //       density of that pressure. A sign error in the gravity term would be off by 2 rho0 |g| dp, 10^7 times the
 //       bound. Wall particles out of every fluid particle's reach (the third layer at the corners) keep p = 0, rho0.
 //   (2) A wall never pulls: fluid at -3 P under a background pressure P gives walls at -P.
+//       A tension beyond the liquid's stiffness (no density in the equation of state) stops with a BlowUpError.
 //   (3) A thin structure standing on the bed and continued into it (a blade's anchor) hides each face's fluid from the
 //       walls across it: with P_left and P_right on its two faces each wall particle takes its own face's pressure.
 TEST_CASE("extrapolated walls take the pressure of the fluid beside them (Adami et al. 2012)", "[walls][fluid]") {
@@ -320,6 +321,14 @@ TEST_CASE("extrapolated walls take the pressure of the fluid beside them (Adami 
     evaluate(f, [](const V2&) { return -300.0; });
     for (std::size_t w = 0; w < p.size(); ++w)
       if (p.kind[w] == Kind::wall && p.pressure[w] != 0.0) CHECK(p.pressure[w] == Approx(-100.0).epsilon(1e-12));
+  }
+  SECTION("a wall pressure without a density stops the run with a diagnosis") {
+    // Tait's stiffness B = rho0 c0^2 / 7 = 32 kPa: a tension of 100 kPa (held by a background pressure that large) has
+    // no density
+    f.gravity = V2::Zero();
+    f.background_pressure = 1e5;
+    CHECK_THROWS_WITH(evaluate(f, [](const V2&) { return -1e5; }),
+                      Catch::Contains("extrapolated walls") && Catch::Contains("no density"));
   }
   SECTION("a thin structure parts the walls under its two faces") {
     f.gravity = V2::Zero();

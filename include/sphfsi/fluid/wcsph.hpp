@@ -59,6 +59,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -325,7 +326,7 @@ class WcsphFluid {
     const auto& p = system.particles();
     const std::size_t n = p.size();
     correction_.resize(n);
-    const bool dynamic_walls = params_.walls != WallModel::repulsive;  // walls in the pressure sums
+    const bool walls_in_sums = params_.walls != WallModel::repulsive;  // walls in the pressure sums
     const bool everywhere = params_.gradient_correction == GradientCorrection::everywhere;
     // Candidates: every fluid particle, or those within the support of a repulsive wall particle (found from the
     // wall side: walls are few).
@@ -343,7 +344,7 @@ class WcsphFluid {
         });
         corrected_[a] = jump;
       });
-    } else if (!dynamic_walls) {
+    } else if (!walls_in_sums) {
       for (std::size_t w = 0; w < n; ++w) {
         if (p.kind[w] != Kind::wall) continue;
         system.for_each_neighbor(w, [&](std::size_t b, const Vector&, T, T) {
@@ -362,7 +363,7 @@ class WcsphFluid {
       system.for_each_neighbor(a, [&](std::size_t b, const Vector& dx, T r, T h) {
         const Kind kb = p.kind[b];
         if (kb == Kind::solid) return;
-        if (kb == Kind::wall && !dynamic_walls) {
+        if (kb == Kind::wall && !walls_in_sums) {
           wall_normal += p.normal[b];
           return;
         }
@@ -400,6 +401,8 @@ class WcsphFluid {
     const Vector g = params_.gravity;
     const T background = params_.background_pressure;
     const bool same_resolution = params_.same_resolution_pairs;
+    constexpr std::size_t none = std::numeric_limits<std::size_t>::max();
+    std::atomic<std::size_t> failed{none};  // a wall particle whose pressure has no density (below -stiffness)
     parallel_for(p.size(), [&](std::size_t w) {
       if (p.kind[w] != Kind::wall || (frozen_ && frozen_[w])) return;
       const T h_w = p.smoothing_length[w];
@@ -419,12 +422,19 @@ class WcsphFluid {
       // eq. 27 with a_w = 0; a wall particle out of every fluid particle's reach keeps the reference state
       const T pressure = std::max(weight > T(0) ? (pressure_sum + g.dot(density_moment)) / weight : T(0), -background);
       const T density = eos.density(pressure);
+      if (!(density > T(0) && std::isfinite(density))) failed = w;
       p.pressure[w] = pressure;
       p.density[w] = density;
       p.sound_speed[w] = eos.sound_speed(density);
       pressure_term_[w] = (pressure + background) / (density * density);
       volume_[w] = p.mass[w] / density;
     });
+    if (const std::size_t w = failed; w != none)
+      throw BlowUpError(fmt::format(
+          "extrapolated walls: wall particle id {} (x = {:.6g} m, vertical {:.6g} m) takes the pressure {:.6g} Pa from "
+          "the fluid it sees, which the equation of state maps to no density (a tension beyond the liquid's "
+          "stiffness)",
+          p.id[w], p.position[w][0], p.position[w][Dim - 1], p.pressure[w]));
   }
 
   // What the pairs of one slot range add to slots beyond it (other ranges): slot begin + k at index k.
@@ -505,7 +515,7 @@ class WcsphFluid {
     const T delta = params_.density_diffusion;
     const T eps_xsph = params_.xsph;
     const T nu = params_.kinematic_viscosity;
-    const bool dynamic_walls = params_.walls != WallModel::repulsive;  // walls in the pressure sums
+    const bool walls_in_sums = params_.walls != WallModel::repulsive;  // walls in the pressure sums
     const bool corrected = params_.gradient_correction != GradientCorrection::none;
     const bool difference_form = params_.gradient_correction == GradientCorrection::resolution_jumps;
     const T* pressure = p.pressure.data();
@@ -545,7 +555,7 @@ class WcsphFluid {
         if (stepping_b) partner.raise_signal_speed(b, std::abs(mu));
         return;
       }
-      if (!dynamic_walls && !(fluid_a && fluid_b)) {  // repulsive wall: pushes the fluid particle only
+      if (!walls_in_sums && !(fluid_a && fluid_b)) {  // repulsive wall: pushes the fluid particle only
         if (fluid_a)
           acc += repulsive_force<Dim, T>(dx, vab, p.normal[b], h, c0, xa[up] - water_level, params_.repulsive);
         else if (stepping_b)
