@@ -390,6 +390,11 @@ class WcsphFluid {
     });
   }
 
+  // Whether a thin structure hides the pair (a, b) from each other in this evaluation (the visibility criterion).
+  bool hidden_by_structure(std::size_t a, std::size_t b, const Vector& xa, const Vector& xb) const noexcept {
+    return occluded_ && (visibility_.near(a) || visibility_.near(b)) && visibility_.blocks(a, b, xa, xb);
+  }
+
   // Extrapolated walls (see the header): each wall particle's pressure, density, sound speed, p / rho^2 and volume
   // from the fluid it sees. Reads fluid slots only and writes wall slots only, so the wall particles run in parallel.
   // A frozen wall particle (local time stepping) keeps its values; with same_resolution_pairs a wall particle sees
@@ -412,8 +417,7 @@ class WcsphFluid {
       system.for_each_neighbor(w, [&](std::size_t f, const Vector& dx, T r, T h) {
         if (p.kind[f] != Kind::fluid) return;
         if (same_resolution && std::abs(p.smoothing_length[f] - h_w) > same_h_tolerance * h_w) return;
-        if (occluded_ && (visibility_.near(w) || visibility_.near(f)) && visibility_.blocks(w, f, x_w, p.position[f]))
-          return;
+        if (hidden_by_structure(w, f, x_w, p.position[f])) return;
         const T w_wf = kernel.value(r, h);
         weight += w_wf;
         pressure_sum += p.pressure[f] * w_wf;
@@ -547,7 +551,7 @@ class WcsphFluid {
       if (frozen_a && !stepping_b) return;
       if (same_resolution && std::abs(h_a - p.smoothing_length[b]) > same_h_tolerance * h_a) return;
       // hidden from each other by a thin structure
-      if (occluded_ && (visibility_.near(a) || visibility_.near(b)) && visibility_.blocks(a, b, xa, x[b])) return;
+      if (hidden_by_structure(a, b, xa, x[b])) return;
       const Vector vab = va - v[b];
       if (passive_a && fluid_b && p.passive[b]) {  // both carried (their rates are zeroed): only the time step's
         const T mu = h * vab.dot(dx) * (T(1) / (r * r + T(0.01) * h * h));  // signal speed, as below
