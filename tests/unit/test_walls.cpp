@@ -9,6 +9,8 @@
 
 #include <cmath>
 #include <numbers>
+#include <utility>
+#include <vector>
 
 using namespace sphfsi;
 namespace tank = sphfsi::examples::tank;
@@ -283,12 +285,14 @@ TEST_CASE("extrapolated walls take the pressure of the fluid beside them (Adami 
   auto& p = system.particles();
   FluidParameters<2, double> f;
   f.walls = WallModel::extrapolated;
-  const auto evaluate = [&](const FluidParameters<2, double>& params, auto&& fluid_pressure) {
+  const auto evaluate = [&](const FluidParameters<2, double>& params, auto&& fluid_pressure,
+                            std::vector<StructureEdge> edges = {}) {
     for (std::size_t i = 0; i < p.size(); ++i) {
       p.density[i] = rho0;
       p.pressure[i] = p.kind[i] == Kind::fluid ? fluid_pressure(p.position[i]) : 12345.0;  // walls: overwritten
     }
     WcsphFluid<System2> fluid(params);
+    fluid.set_structure_edges(std::move(edges));
     system.update_neighbors();
     fluid.compute_rates(system);
   };
@@ -345,14 +349,8 @@ TEST_CASE("extrapolated walls take the pressure of the fluid beside them (Adami 
       if (k > 0) edges.push_back({last, id});
       last = id;
     }
-    for (std::size_t i = 0; i < p.size(); ++i) {
-      p.density[i] = rho0;
-      p.pressure[i] = p.kind[i] == Kind::fluid ? (p.position[i][0] < x0 ? p_left : p_right) : 0.0;
-    }
-    WcsphFluid<System2> fluid(f);
-    fluid.set_structure_edges(edges);
-    system.update_neighbors();
-    fluid.compute_rates(system);
+    evaluate(
+        f, [&](const V2& x) { return x[0] < x0 ? p_left : p_right; }, edges);
     std::size_t under = 0;
     for (std::size_t w = 0; w < p.size(); ++w) {
       if (p.kind[w] != Kind::wall || p.pressure[w] == 0.0) continue;
