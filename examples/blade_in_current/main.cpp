@@ -178,7 +178,7 @@ T fluid_under_blade(const ParticleSet<2, T>& p, const Ids& ids, T dp) {
 }
 
 /// Runs one blade: flexible at the target Cauchy number, or rigid (target_ca = 0). `inclination`: the blade's rest
-/// angle from the vertical, leaning downstream (rad; the rigid blades of the force-law sweep, 2D only). Dim = 3: the
+/// angle from the vertical, leaning downstream (rad; the rigid blades of the force-law sweep). Dim = 3: the
 /// blade is a strip of width b (a ribbon, solid/elastic_rod.hpp) in the middle of a channel of width W; forces are
 /// then per blade (N), in 2D per unit width (N/m).
 template <int Dim, class Coupling>
@@ -209,14 +209,15 @@ CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
   const V direction(-std::sin(inclination), std::cos(inclination));
   const V mount(
       x0, target_ca > 0 && !o.clamp_middle ? T(0) : std::round(o.mount_height * l / dp) * dp);  // the blade's base
-  if constexpr (Dim == 2) {
-    if (inclination != 0) {
-      auto& p = system.particles();
-      for (std::size_t k = p.size(); k-- > 0;) {
-        const V r = p.position[k] - mount;
-        const T along = std::clamp(r.dot(direction), T(0), l);
-        if ((r - along * direction).norm() < dp / 2) p.remove(k);
-      }
+  // In 3D only across the strip's width (|y| < b / 2): the water beside its edges stays.
+  if (inclination != 0) {
+    auto& p = system.particles();
+    for (std::size_t k = p.size(); k-- > 0;) {
+      const VD& x = p.position[k];
+      if (Dim == 3 && !(std::abs(x[1]) < o.blade_width / 2)) continue;
+      const V r = V(x[0], x[Dim - 1]) - mount;
+      const T along = std::clamp(r.dot(direction), T(0), l);
+      if ((r - along * direction).norm() < dp / 2) p.remove(k);
     }
   }
   add_box_walls(system, at(0, -half_width, 0), at(tank, half_width, depth), res, WallModel::dynamic);
@@ -415,7 +416,9 @@ CaseResult run_case(const Options& o, T target_ca, T inclination = 0) {
 /// The local force law of the resolved blade, measured on rigid blades inclined by theta from the vertical: per unit
 /// length, in units of (1/2) rho U^2 C_N(0) (the upright blade's normal load), the normal load (on the downstream
 /// face's normal) and the tangential load (along the blade, base to tip). The flexible blade at the same Ca, posed
-/// as Luhar & Nepf's static balance but with this law, is analysis::static_reconfiguration.
+/// as Luhar & Nepf's static balance but with this law, is analysis::static_reconfiguration. Dim = 3: strips of width
+/// b in the 3D channel (forces per blade, loads per unit length of the strip, in units of (1/2) rho U^2 C_N(0) b).
+template <int Dim>
 int run_force_law_sweep(const Options& o) {
   if (o.coupling != "repulsive")
     throw InputError("--inclinations: the force law of the resolved blade needs --coupling repulsive");
@@ -426,18 +429,20 @@ int run_force_law_sweep(const Options& o) {
     if (k > 0 && !(o.inclinations[k] > o.inclinations[k - 1]))
       throw InputError(fmt::format("--inclinations: {} is not above the angle before it", o.inclinations[k]));
   }
-  const T pi = std::numbers::pi_v<T>, rho = 1000, dynamic = T(0.5) * rho * o.speed * o.speed * o.length;
+  const T pi = std::numbers::pi_v<T>, rho = 1000;
+  const T dynamic = T(0.5) * rho * o.speed * o.speed * o.length * (Dim == 3 ? o.blade_width : T(1));
   io::CsvWriter csv(o.output / "inclined.csv",
                     {"inclination_deg", "drag", "drag_error", "lift", "lift_error", "normal_coefficient",
                      "tangential_coefficient", "normal_load", "tangential_load", "steps", "wall_s"});
   fmt::print(
-      "| inclination | drag F_x (N/m) | lift F_z (N/m) | C_N | C_T | C_N / C_N(0) | cos^2 | C_T / C_N(0) | wall (s) |\n"
-      "|---|---|---|---|---|---|---|---|---|\n");
+      "| inclination | drag F_x ({0}) | lift F_z ({0}) | C_N | C_T | C_N / C_N(0) | cos^2 | C_T / C_N(0) | wall (s) "
+      "|\n|---|---|---|---|---|---|---|---|---|\n",
+      Dim == 3 ? "N" : "N/m");
   T upright = 0;
   for (const T degrees : o.inclinations) {
     fmt::print("--- rigid blade inclined by {:g} degrees\n", degrees);
     const T theta = degrees * pi / 180;
-    const CaseResult r = run_case<2, RepulsiveForce<T>>(o, 0, theta);
+    const CaseResult r = run_case<Dim, RepulsiveForce<T>>(o, 0, theta);
     // Decomposed on the blade: n = (-cos, -sin) is the downstream face's normal (the blade leans towards -x, the
     // water moves along -x relative to it), t = (-sin, cos) its tangent. drag = -F_x, lift = F_z.
     const T normal = r.drag * std::cos(theta) - r.lift * std::sin(theta);
@@ -588,10 +593,7 @@ int main(int argc, char** argv) try {
   o.cauchy = parse_list(list);
   o.inclinations = parse_list(inclination_list);
   std::filesystem::create_directories(o.output);
-  if (!o.inclinations.empty()) {
-    if (o.three_d) throw InputError("--inclinations: the force-law sweep is 2D (leave out --three-d)");
-    return run_force_law_sweep(o);
-  }
+  if (!o.inclinations.empty()) return o.three_d ? run_force_law_sweep<3>(o) : run_force_law_sweep<2>(o);
   if (o.cauchy.empty() || (o.end_time == 0 && o.rigid_from.empty() && o.cauchy.front() != 0))
     throw InputError(
         "--cauchy must start with 0 (the rigid blade that every l_e / l is measured against), or give --rigid-from");

@@ -157,7 +157,8 @@ scenes::PosidoniaFlume<T> converted(const scenes::PosidoniaFlume<double>& s) {
                   s.refinement.follow_flow,
                   T(s.refinement.distant_fit_interval),
                   T(s.refinement.edge_dither),
-                  s.refinement.wall_faces};
+                  s.refinement.wall_faces,
+                  s.refinement.paired_statuses};
   return c;
 }
 
@@ -926,6 +927,10 @@ int main(int argc, char** argv) try {
       "refinement: the box's bed face (and its top above the crests) counts as a wall, not an edge: no dither, "
       "hysteresis or account band there (off: the accounts' band takes in the box's bottom transition width, as in "
       "sessions 14-29): on | off");
+  s.refinement.paired_statuses = cli.get_switch(
+      "paired-statuses", false,
+      "refinement: a fine particle near a box edge is active exactly when the nearest coarse one is passive, so the "
+      "water changes hands cell by cell (off: each particle's status follows its own position): on | off");
   o.local_steps = cli.get_switch("local-steps", false,
                                  "refinement: local time stepping, the coarse fluid at twice the fine step: on | off");
   o.fine_step_margin = cli.get_number(

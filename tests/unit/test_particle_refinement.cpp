@@ -1170,7 +1170,7 @@ TEST_CASE("adaptive refinement: status hysteresis stops particles oscillating ac
 TEST_CASE("adaptive refinement: dithered box edges let a lattice column change status particle by particle",
           "[refinement][apr]") {
   constexpr double dp = 0.01;
-  auto drift = [&](double dither) {
+  auto drift = [&](double dither, bool paired) {
     AprSystem system{Domain<2, double>(V2(-0.1, -0.1), V2(0.7, 0.5)), Tait<double>(1000, 20)};
     for (int i = 0; i < 40; ++i)
       for (int j = 0; j < 40; ++j)
@@ -1183,6 +1183,7 @@ TEST_CASE("adaptive refinement: dithered box edges let a lattice column change s
     params.conserve_mass = false;
     params.conserve_momentum = false;
     params.edge_dither = dither;
+    params.paired_statuses = paired;
     Apr apr(system.domain(), {{V2(8 * dp, 4 * dp), V2(0.55, 36 * dp), 1}}, params);
     apr.populate(system);
     auto& p = system.particles();
@@ -1199,14 +1200,22 @@ TEST_CASE("adaptive refinement: dithered box edges let a lattice column change s
     }
     return std::pair{worst, std::sqrt(sum2 / passes)};
   };
-  const auto [worst_abrupt, rms_abrupt] = drift(0);
-  const auto [worst_dithered, rms_dithered] = drift(1);
+  const auto [worst_abrupt, rms_abrupt] = drift(0, false);
+  const auto [worst_dithered, rms_dithered] = drift(1, false);
+  const auto [worst_paired, rms_paired] = drift(0, true);
+  const auto [worst_paired_dithered, rms_paired_dithered] = drift(1, true);
   INFO("active mass change, columns: abrupt edges worst "
-       << worst_abrupt << " rms " << rms_abrupt << "; dithered worst " << worst_dithered << " rms " << rms_dithered);
+       << worst_abrupt << " rms " << rms_abrupt << "; dithered worst " << worst_dithered << " rms " << rms_dithered
+       << "; paired worst " << worst_paired << " rms " << rms_paired << "; paired and dithered worst "
+       << worst_paired_dithered << " rms " << rms_paired_dithered);
   CHECK(worst_abrupt == Approx(0.5).epsilon(1e-9));
   CHECK(rms_abrupt == Approx(std::sqrt(0.125)).epsilon(1e-9));
   CHECK(rms_dithered <= 0.081 * 1.5);  // the count's spread, with the margin of one realisation's rms
   CHECK(worst_dithered <= 0.25);       // half the sawtooth
+  // Paired statuses: each coarse particle changes status with the four fine ones of its cell, so the lattice hands
+  // over whole cells and the active mass keeps its start value; with or without dither.
+  CHECK(worst_paired <= 1e-12);
+  CHECK(worst_paired_dithered <= 1e-12);
 
   AdaptiveRefinementParameters<double> bad;
   bad.base_spacing = dp;
@@ -1216,6 +1225,11 @@ TEST_CASE("adaptive refinement: dithered box edges let a lattice column change s
   bad.edge_dither = 2;
   bad.status_hysteresis = 2.5;  // 4 - 1.3 - 1 = 1.7 at most
   CHECK_THROWS_WITH(bad.validate(), Catch::Contains("status_hysteresis"));
+  bad.edge_dither = 0;
+  bad.status_hysteresis = 2.5;  // 4 - 1.3 = 2.7 at most, 1.7 with paired statuses
+  CHECK_NOTHROW(bad.validate());
+  bad.paired_statuses = true;
+  CHECK_THROWS_WITH(bad.validate(), Catch::Contains("paired_statuses"));
 }
 
 // Wall faces (RefinementBox::wall_faces): a box standing on the bottom of the block (its lower face at y = 0, where no

@@ -157,6 +157,15 @@ struct AdaptiveRefinementParameters {
   /// active mass no longer depends on where the lattice stands against the edge (dithering, as in signal
   /// quantisation). 0: the edges are where the boxes say.
   T edge_dither{0};
+  /// Whether a refined particle near a box edge takes its status from the coarser particle that stands for the same
+  /// water (paired statuses): a particle of level k >= 1 within transition_width of an edge, not inside a box finer
+  /// than k, is active exactly when the nearest particle of level k - 1 is passive, and that one's status follows
+  /// its position (with status_hysteresis and edge_dither). The fine particles nearest a coarse one are its own
+  /// children's places (2^Dim of them on the split lattice), so when a coarse particle changes status the fine
+  /// particles of its cell change the other way in the same pass and the water changes hands in one piece: the
+  /// active mass no longer swings by whole columns of one level (docs/variable-resolution.md, session 33). Statuses
+  /// are decided level by level, coarse first. 0 / false: every particle's status follows its own position.
+  bool paired_statuses{false};
   /// Whether the statuses populate() gave are carried by the particles from then on (Lagrangian statuses): after
   /// populate() a pass changes no status, creates no child and removes no particle; it only fits the passive
   /// particles' values. The refined region is then a patch of water that moves with the flow (the particles of each
@@ -201,11 +210,13 @@ struct AdaptiveRefinementParameters {
     // a fine particle kept active up to the hysteresis outside its box needs its whole support of fine particles
     // (2 h of level 1 = smoothing_ratio base spacings) inside the transition zone
     require_in_range("AdaptiveRefinementParameters::edge_dither (base spacings)", edge_dither, T(0), T(2));
+    // paired statuses: a fine particle follows the nearest coarse one, up to half a coarse diagonal farther out
     require_in_range(
         "AdaptiveRefinementParameters::status_hysteresis (base spacings; at most transition_width / "
-        "base_spacing - smoothing_ratio - edge_dither / 2)",
+        "base_spacing - smoothing_ratio - edge_dither / 2, less 1 with paired_statuses)",
         status_hysteresis, T(0),
-        std::max(T(0), transition_width / base_spacing - smoothing_ratio - T(0.5) * edge_dither));
+        std::max(T(0), transition_width / base_spacing - smoothing_ratio - T(0.5) * edge_dither -
+                           (paired_statuses ? T(1) : T(0))));
     require_in_range("AdaptiveRefinementParameters::mass_account_relaxation (tau, s)", mass_account_relaxation, T(0),
                      T(1e6));
     require_in_range("AdaptiveRefinementParameters::distant_fit_interval (s)", distant_fit_interval, T(0), T(1));
@@ -311,6 +322,17 @@ class AdaptiveRefinement {
       const AdaptiveRefinementCounts c = pass(system, level, T(0));
       accumulate(c);
       if (c.created == 0 && level >= max_box_level()) break;
+    }
+    if (params_.paired_statuses) {  // the first pass's statuses already, so that it hands nothing over
+      auto& p = system.particles();
+      level_.assign(p.size(), 0);
+      leaving_.assign(p.size(), 0);
+      status_.assign(p.passive.begin(), p.passive.end());
+      for (std::size_t a = 0; a < p.size(); ++a)
+        if (p.kind[a] == Kind::fluid) level_[a] = level_of_particle(p, a);
+      pair_statuses(system);
+      for (std::size_t a = 0; a < p.size(); ++a)
+        if (p.kind[a] == Kind::fluid) p.passive[a] = status_[a];
     }
     check_walls(system);
   }
@@ -515,6 +537,31 @@ class AdaptiveRefinement {
     counts.momentum_correction = static_cast<double>(shift.norm());
   }
 
+  // Paired statuses (AdaptiveRefinementParameters::paired_statuses): level by level from the coarsest refined one,
+  // each particle of level k >= 1 near a box edge and not inside a finer box takes the opposite of the status of the
+  // nearest particle of level k - 1 (whose status is final by then). Reads status_ of level k - 1, writes level k.
+  void pair_statuses(System& system) {
+    const auto& p = system.particles();
+    const int top = max_box_level();
+    for (int k = 1; k <= top; ++k) {
+      parallel_for(p.size(), [&](std::size_t a) {
+        if (p.kind[a] != Kind::fluid || leaving_[a] || level_[a] != k || !near_box_edge(p.position[a])) return;
+        if (highest_level(p.position[a], dither_offset(p.id[a])) > k) return;
+        T nearest = std::numeric_limits<T>::infinity();
+        std::size_t coarse = p.size();
+        system.for_each_neighbor_of_size(a, T(2) * p.smoothing_length[a], level_tolerance,
+                                         [&](std::size_t b, const Vector&, T r, T) {
+                                           if (p.kind[b] == Kind::fluid && !leaving_[b] && level_[b] == k - 1 &&
+                                               (r < nearest || (r == nearest && b < coarse))) {
+                                             nearest = r;
+                                             coarse = b;
+                                           }
+                                         });
+        if (coarse < p.size()) status_[a] = status_[coarse] ? 0 : 1;
+      });
+    }
+  }
+
   // Mass of a particle of level k: rho0 (dp / 2^k)^Dim (the scene's base particles have rho0 dp^Dim).
   T nominal_mass(int k, T rho0) const { return rho0 * cell_volume(spacing_of(k)); }
   // Spacing of level k, dp / 2^k, m, and the volume s^Dim of a lattice cell of spacing s (per-particle hot paths: no
@@ -544,6 +591,7 @@ class AdaptiveRefinement {
     const T hysteresis = params_.status_hysteresis * params_.base_spacing;
     level_.assign(n, 0);
     leaving_.assign(n, 0);
+    status_.assign(n, 0);
     removals_.clear();
     for (std::size_t a = 0; a < n; ++a) {
       if (p.kind[a] != Kind::fluid) continue;
@@ -563,6 +611,13 @@ class AdaptiveRefinement {
                   loose = highest_level(p.position[a], dither + hysteresis);
         if (strict != loose && (k == strict || k == loose)) passive = p.passive[a];
       }
+      status_[a] = passive;
+    }
+    if (params_.paired_statuses && initial_level < 0) pair_statuses(system);
+    for (std::size_t a = 0; a < n; ++a) {
+      if (p.kind[a] != Kind::fluid || leaving_[a]) continue;
+      const int k = level_[a];
+      const std::uint8_t passive = status_[a];
       if (passive != p.passive[a]) {
         ++(passive ? counts.deactivated : counts.activated);
         const double sign = passive ? -1.0 : 1.0;
@@ -806,8 +861,10 @@ class AdaptiveRefinement {
   // a finer particle outside the boxes of its level by more than that, or a coarser one deeper than that inside a
   // finer box.
   bool distant(const Vector& x, int k) const {
-    const T reach = T(2 * System::kernel_type::support) * params_.smoothing_ratio * spacing_of(k) +
-                    (params_.status_hysteresis + T(0.5) * params_.edge_dither) * params_.base_spacing;
+    const T reach =
+        T(2 * System::kernel_type::support) * params_.smoothing_ratio * spacing_of(k) +
+        (params_.status_hysteresis + T(0.5) * params_.edge_dither + (params_.paired_statuses ? T(1) : T(0))) *
+            params_.base_spacing;
     const int inside = level_inside(x);
     if (k > inside) return highest_level(x, reach) < k;
     if (k < inside) return highest_level(x, -reach) > k;
@@ -856,6 +913,7 @@ class AdaptiveRefinement {
   std::vector<int> level_;                   // per slot of the pass: level
   std::vector<std::uint8_t> missing_;        // per slot: passive without an active neighbour of another level
   std::vector<std::uint8_t> leaving_;        // per slot of the pass: 1 if removed in it
+  std::vector<std::uint8_t> status_;         // per slot of the pass: the new passive flag
   T lattice_number_density_{1};              // lattice_number_density() of the kernel (populate)
   std::vector<std::size_t> removals_;        // slots to remove
   std::vector<Child> created_;               // children to create

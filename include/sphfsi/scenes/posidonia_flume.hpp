@@ -96,6 +96,9 @@ struct PlantRefinement {
   /// face counts as an edge, so the accounts' band takes in the bottom transition width of the box. Measured, the
   /// wall faces do not bring the refined run closer to the fine one (docs/variable-resolution.md, session 30).
   bool wall_faces{false};
+  /// AdaptiveRefinementParameters::paired_statuses: a fine particle near a box edge takes the opposite status of the
+  /// nearest coarse one, so a coarse particle and the fine ones of its cell change status together
+  bool paired_statuses{false};
 };
 
 /// The Posidonia flume: waves, resolution, plants and blade model (lengths in m).
@@ -230,6 +233,7 @@ struct PosidoniaFlume {
     a.boxes_follow_flow = refinement.follow_flow;
     a.distant_fit_interval = refinement.distant_fit_interval;
     a.edge_dither = refinement.edge_dither;
+    a.paired_statuses = refinement.paired_statuses;
     return a;
   }
   /// The real blade as a line of rod nodes (rod, drag), not a continuum of particle rows (scaled, equivalent).
