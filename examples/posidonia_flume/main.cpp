@@ -158,7 +158,9 @@ scenes::PosidoniaFlume<T> converted(const scenes::PosidoniaFlume<double>& s) {
                   T(s.refinement.distant_fit_interval),
                   T(s.refinement.edge_dither),
                   s.refinement.wall_faces,
-                  s.refinement.paired_statuses};
+                  s.refinement.paired_statuses,
+                  s.refinement.account_over_all_fluid,
+                  s.refinement.passive_mass_from_volume};
   return c;
 }
 
@@ -931,6 +933,16 @@ int main(int argc, char** argv) try {
       "paired-statuses", false,
       "refinement: a fine particle near a box edge is active exactly when the nearest coarse one is passive, so the "
       "water changes hands cell by cell (off: each particle's status follows its own position): on | off");
+  const std::string account_region = cli.get(
+      "account-region", "edges",
+      "refinement: the accounts hand their changes to the active particles near the box edges (edges) or to all "
+      "active fluid (all)");
+  if (account_region != "edges" && account_region != "all")
+    throw InputError(fmt::format("--account-region '{}': valid are edges, all", account_region));
+  s.refinement.account_over_all_fluid = account_region == "all";
+  s.refinement.passive_mass_from_volume =
+      cli.get_switch("volume-mass", true,
+                     "refinement: passive masses from their SPH volume, capped at nominal (off: nominal): on | off");
   o.local_steps = cli.get_switch("local-steps", false,
                                  "refinement: local time stepping, the coarse fluid at twice the fine step: on | off");
   o.fine_step_margin = cli.get_number(
