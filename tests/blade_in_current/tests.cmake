@@ -26,6 +26,19 @@ if(TARGET blade_in_current)
            COMMAND blade_in_current --resolution 16 --length 0.1 --depth 3 --mount-height 1 --clamp-middle on
                    --walls extrapolated --cauchy 0,100 --end-time 0.15 --background-pressure 4 --contact-gap 0.5
                    --output ${CMAKE_CURRENT_BINARY_DIR}/blade_double_extrapolated)
+  # The force-law sweep of 3D strips (session 33) on extrapolated walls, 1 towing length at l / dp = 6 (about 30 s on one
+  # thread), and its inclined.csv read back by --static-only (the static blade under the measured law, no run).
+  add_test(NAME blade_in_current.force_law_3d
+           COMMAND blade_in_current --three-d on --resolution 6 --depth 2 --channel-width 3 --inclinations 0,45
+                   --tow-lengths 1 --average-from 0 --background-pressure 4 --walls extrapolated
+                   --output ${CMAKE_CURRENT_BINARY_DIR}/blade_force_law_3d)
+  add_test(NAME blade_in_current.static_only
+           COMMAND blade_in_current --static-only on --cauchy 10,100
+                   --force-law ${CMAKE_CURRENT_BINARY_DIR}/blade_force_law_3d/inclined.csv)
+  set_tests_properties(blade_in_current.force_law_3d PROPERTIES FIXTURES_SETUP blade_force_law_3d)
+  set_tests_properties(blade_in_current.static_only PROPERTIES FIXTURES_REQUIRED blade_force_law_3d)
+  set_tests_properties(blade_in_current.force_law_3d blade_in_current.static_only PROPERTIES LABELS "regression"
+                       TIMEOUT 120 ENVIRONMENT "OMP_NUM_THREADS=1;OMP_WAIT_POLICY=passive")
   set_tests_properties(blade_in_current.double_blade_extrapolated_walls PROPERTIES LABELS "regression" TIMEOUT 120
                        ENVIRONMENT "OMP_NUM_THREADS=1;OMP_WAIT_POLICY=passive")
   set_tests_properties(blade_in_current.ribbon_3d PROPERTIES LABELS "regression" TIMEOUT 120

@@ -46,6 +46,10 @@
 // that a column of particles crossing an edge together (a lattice; the water column of a wave's orbital motion)
 // changes status particle by particle, not all at once.
 //
+// Paired statuses (paired_statuses): near a box edge a finer particle is active exactly when the nearest particle of
+// the next coarser level is passive, so a coarse particle and the fine particles of its cell change status together
+// and the water changes hands cell by cell, not column by column.
+//
 // Boxes that follow the flow (boxes_follow_flow): the boxes move along x with the mean velocity of the finest active
 // fluid in them, so that a wave's orbital motion carries the edges with the water.
 //
