@@ -554,10 +554,11 @@ int main(int argc, char** argv) try {
   o.force_law = cli.get("force-law", "",
                         "inclined.csv of a force-law sweep: the static reconfiguration under that measured local law "
                         "is added to the Cauchy sweep's summary (column model_2d)");
-  o.static_only = cli.get_switch(
-      "static-only", false,
-      "on: no run; for each Ca of --cauchy (the Cauchy numbers themselves, with the measured C_D in them) print Luhar & "
-      "Nepf's fit, their static balance and the static balance under the law of --force-law");
+  o.static_only =
+      cli.get_switch("static-only", false,
+                     "on: no run; for each Ca of --cauchy (the Cauchy numbers themselves, with the measured C_D in "
+                     "them) print Luhar & "
+                     "Nepf's fit, their static balance and the static balance under the law of --force-law");
   o.three_d = cli.get_switch("three-d", false,
                              "on: a 3D channel with a strip of width --blade-width (a ribbon: the water passes its "
                              "sides) | off: the 2D full-width blade");
