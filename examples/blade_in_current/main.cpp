@@ -101,6 +101,7 @@ struct Options {
   // 3D: a strip of width b (a ribbon) in the middle of a channel of width W, so that the water can pass the blade's
   // sides as round Luhar & Nepf's blades (b / l = 0.2), instead of the 2D full-width blade
   bool three_d = false;
+  // no run: the static blade under the model's law and under the measured one of force_law, for each Ca of cauchy
   bool static_only = false;
   T blade_width = T(0.01);  // b, m (2D: the porous blade's added mass only)
   T channel_width = 6;      // 3D: W / b, rounded to whole fluid spacings
@@ -557,8 +558,8 @@ int main(int argc, char** argv) try {
   o.static_only =
       cli.get_switch("static-only", false,
                      "on: no run; for each Ca of --cauchy (the Cauchy numbers themselves, with the measured C_D in "
-                     "them) print Luhar & "
-                     "Nepf's fit, their static balance and the static balance under the law of --force-law");
+                     "them) print Luhar & Nepf's fit, their static balance and the static balance under the law of "
+                     "--force-law");
   o.three_d = cli.get_switch("three-d", false,
                              "on: a 3D channel with a strip of width --blade-width (a ribbon: the water passes its "
                              "sides) | off: the 2D full-width blade");
@@ -602,10 +603,11 @@ int main(int argc, char** argv) try {
   if (!o.inclinations.empty()) return o.three_d ? run_force_law_sweep<3>(o) : run_force_law_sweep<2>(o);
   if (o.static_only) {  // the static blade under the model's law and under a measured one, no SPH run
     if (o.force_law.empty()) throw InputError("--static-only on needs --force-law (an inclined.csv)");
+    if (o.cauchy.empty()) throw InputError("--static-only on needs --cauchy (one or more Cauchy numbers)");
+    for (const T ca : o.cauchy) require_in_range("--cauchy (with --static-only)", ca, T(1e-3), T(1e6));
     const auto law = read_force_law(o.force_law);
     fmt::print("| Ca | l_e / l fit | static, cos^2 | static, measured law |\n|---|---|---|---|\n");
     for (const T ca : o.cauchy) {
-      require_in_range("--cauchy (with --static-only)", ca, T(1e-3), T(1e6));
       fmt::print("| {:g} | {:.4f} | {:.4f} | {:.4f} |\n", ca, analysis::luhar_nepf_effective_length_fit(ca),
                  analysis::luhar_nepf_reconfiguration(ca).effective_length,
                  analysis::static_reconfiguration(ca, law.first, law.second).effective_length);
