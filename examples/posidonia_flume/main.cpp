@@ -62,6 +62,7 @@ struct Options {
   double waves_analysed{4};
   double end_time{0};
   double snapshots{0};
+  double flow_map_from{-1};  // --flow-map-from: time the period-mean flow map starts averaging, s (< 0: no map)
   bool run_plants{true}, run_empty{true};
   bool check{false};  // exit 4 unless every plant sways with the water beside it and stands (see --check)
   // Rod blades: fluid pairs across a blade do not interact (fluid/thin_structure_visibility.hpp).
@@ -119,6 +120,133 @@ double eulerian_velocity(const System& system, const Vec<2, typename System::sca
   }
   return sum_w > T(0) ? double(sum_u / sum_w) : 0.0;
 }
+
+/// Time-mean map of the active fluid on a grid of square bins (flow_map.csv): per bin the mean number of active and
+/// passive particles of the coarse (level 0) and fine (level >= 1) resolution, the mean mass per area, the mean
+/// volume fraction sum m / rho / A, the mean mass flux sum m u / (rho0 A) (a transport velocity, m/s: divergence-free
+/// in a steady mean flow unless the bin holds a source of active mass), and the active mass the refinement's passes
+/// created there per unit time and area, split into status changes (a particle that became active with its mass, or
+/// passive) and the accounts (an active particle's mass rescaled), kg / (m^3 s). Diagnoses where a refined run makes
+/// or loses water (docs/variable-resolution.md, session 34).
+template <class System>
+class FlowMap {
+ public:
+  using T = typename System::scalar_type;
+  FlowMap(double x0, double x1, double z1, double bin, double rho0, double base_smoothing, double base_spacing)
+      : x0_(x0),
+        bin_(bin),
+        rho0_(rho0),
+        base_smoothing_(base_smoothing),
+        base_spacing_(base_spacing),
+        nx_(static_cast<std::size_t>(std::ceil((x1 - x0) / bin))),
+        nz_(static_cast<std::size_t>(std::ceil(z1 / bin))),
+        sums_(nx_ * nz_ * fields, 0.0) {}
+
+  /// Every step: the active mass each particle gained since the last step (status changes and accounts), binned,
+  /// from `from` on.
+  void track(const System& s, double t, double from) {
+    const auto& p = s.particles();
+    const bool counting = t >= from && tracked_;
+    for (std::size_t a = 0; a < p.size(); ++a) {
+      if (p.kind[a] != Kind::fluid) continue;
+      const std::size_t id = p.id[a];
+      if (id >= previous_.size()) previous_.resize(id + 1, std::numeric_limits<double>::quiet_NaN());
+      const double m = p.passive[a] ? 0.0 : double(p.mass[a]);
+      const double before = previous_[id];
+      previous_[id] = m;
+      if (!counting || std::isnan(before) || m == before) continue;
+      const std::size_t b = bin_of(p.position[a]);
+      if (b == npos) continue;
+      const bool status_change = (before == 0.0) != (m == 0.0);
+      sums_[b * fields + (status_change ? status_source : account_source)] += m - before;
+    }
+    if (counting && last_track_ >= from) tracked_time_ += t - last_track_;
+    last_track_ = t;
+    tracked_ = true;
+  }
+
+  /// At each sample time from `from` on: the particles' counts, mass, volume and mass flux, binned.
+  void sample(const System& s) {
+    const auto& p = s.particles();
+    for (std::size_t a = 0; a < p.size(); ++a) {
+      if (p.kind[a] != Kind::fluid) continue;
+      const std::size_t b = bin_of(p.position[a]);
+      if (b == npos) continue;
+      const bool fine = level_of(double(p.smoothing_length[a])) > 0;
+      double* c = &sums_[b * fields];
+      if (p.passive[a]) {
+        c[fine ? passive_fine : passive_coarse] += 1;
+        continue;
+      }
+      c[fine ? active_fine : active_coarse] += 1;
+      const double m = double(p.mass[a]);
+      c[mass] += m;
+      c[volume] += m / double(p.density[a]);
+      c[flux_x] += m * double(p.velocity[a][0]);
+      c[flux_z] += m * double(p.velocity[a][1]);
+      if (fine) c[fine_mass_ratio] += m / nominal_mass(level_of(double(p.smoothing_length[a])));
+    }
+    ++samples_;
+  }
+
+  void write(const std::filesystem::path& file, double from) const {
+    io::CsvWriter csv(file,
+                      {"x", "z", "active_coarse", "active_fine", "passive_coarse", "passive_fine", "mass_per_area",
+                       "volume_fraction", "flux_x", "flux_z", "fine_mass_ratio", "status_source", "account_source"},
+                      fmt::format("time-mean map of the active fluid from t = {} s ({} samples, {:.4f} s tracked); "
+                                  "bins of {} m, centres x, z (m); mean particle counts per bin; mass per area "
+                                  "kg/m^3; flux = sum m u / (rho0 A), m/s; fine_mass_ratio: mean mass / nominal of the "
+                                  "active fine particles; sources: active mass created per time and area, kg/(m^3 s)",
+                                  from, samples_, tracked_time_, bin_));
+    const double area = bin_ * bin_, n = std::max<double>(double(samples_), 1.0);
+    const double duration = tracked_time_ > 0 ? tracked_time_ : 1.0;
+    for (std::size_t i = 0; i < nx_; ++i)
+      for (std::size_t k = 0; k < nz_; ++k) {
+        const double* c = &sums_[(i * nz_ + k) * fields];
+        const double fine_count = c[active_fine];
+        csv.write_row({x0_ + (double(i) + 0.5) * bin_, (double(k) + 0.5) * bin_, c[active_coarse] / n,
+                       c[active_fine] / n, c[passive_coarse] / n, c[passive_fine] / n, c[mass] / n / area,
+                       c[volume] / n / area, c[flux_x] / n / area / rho0_, c[flux_z] / n / area / rho0_,
+                       fine_count > 0 ? c[fine_mass_ratio] / fine_count : 0.0, c[status_source] / duration / area,
+                       c[account_source] / duration / area});
+      }
+  }
+
+ private:
+  enum Field : std::size_t {
+    active_coarse,
+    active_fine,
+    passive_coarse,
+    passive_fine,
+    mass,
+    volume,
+    flux_x,
+    flux_z,
+    fine_mass_ratio,
+    status_source,
+    account_source,
+    fields
+  };
+  static constexpr std::size_t npos = std::numeric_limits<std::size_t>::max();
+  std::size_t bin_of(const Vec<2, T>& x) const {
+    const double i = std::floor((double(x[0]) - x0_) / bin_), k = std::floor(double(x[1]) / bin_);
+    if (!(i >= 0 && k >= 0 && i < double(nx_) && k < double(nz_))) return npos;
+    return static_cast<std::size_t>(i) * nz_ + static_cast<std::size_t>(k);
+  }
+  int level_of(double h) const { return static_cast<int>(std::lround(std::log2(base_smoothing_ / h))); }
+  double nominal_mass(int level) const {
+    const double s = std::ldexp(base_spacing_, -level);
+    return rho0_ * s * s;
+  }
+
+  double x0_, bin_, rho0_, base_smoothing_, base_spacing_;
+  std::size_t nx_, nz_;
+  std::vector<double> sums_;
+  std::vector<double> previous_;  // active mass of each particle id at the last step (0: passive; NaN: unseen)
+  std::size_t samples_{0};
+  double tracked_time_{0}, last_track_{0};
+  bool tracked_{false};
+};
 
 template <class T>
 scenes::PosidoniaFlume<T> converted(const scenes::PosidoniaFlume<double>& s) {
@@ -308,6 +436,12 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
   io::CsvWriter currents_csv(dir / "currents.csv", current_columns,
                              "Eulerian horizontal velocity (m/s) of the active fluid at x (m, first number) and height "
                              "above the bed (m, second number)");
+  // the period-mean map of the active fluid (--flow-map-from): from 0.4 m before the first gauge past the paddle's
+  // ramp to the absorber, up to above the crests, in bins of half the fine spacing (dp / 2 of the refined runs)
+  std::optional<FlowMap<System>> flow_map;
+  if (o.flow_map_from >= 0)
+    flow_map.emplace(0.5, 1.9, 1.3 * double(scene.depth), 0.0025, double(system.eos().reference_density()),
+                     double(g.smoothing_ratio * scene.dp()), double(scene.dp()));
   // the active fluid's volume sum m / rho and mass, per unit width: a refinement box's status changes move water
   // between the active and the passive fluid, and its mass account hands the difference back at fixed density
   io::CsvWriter volume_csv(
@@ -354,6 +488,7 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
     sim.run(T(r.end_time), [&](Solver& sm) {
       progress(sm);
       r.particle_steps = sm.particle_steps();
+      if (flow_map) flow_map->track(sm.system(), double(sm.time()), o.flow_map_from);
       if constexpr (Rods && !Drag) {
         // Every step (porous blades: the water passes): between samples a particle beside the tip could go round it.
         crossings.update(sm.system(), sm.template model<1>());
@@ -361,6 +496,7 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
       if (double(sm.time()) + 1e-9 >= next_sample) {
         gauges.sample(sm.system(), sm.time());
         record_volume(sm.system(), double(sm.time()));
+        if (flow_map && double(sm.time()) >= o.flow_map_from) flow_map->sample(sm.system());
         {
           std::vector<double> row{double(sm.time())};
           for (double x : current_x)
@@ -418,6 +554,7 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
     vtk.write(system.particles(), sim.time());
   }
   progress.finish(sim);
+  if (flow_map) flow_map->write(dir / "flow_map.csv", o.flow_map_from);
   r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   r.steps = sim.step_count();
   r.reached = double(sim.time());
@@ -882,6 +1019,11 @@ int main(int argc, char** argv) try {
   o.waves_analysed = cli.get_number("waves", 4, "full-amplitude waves recorded at the last gauge");
   o.end_time = cli.get_number("end-time", 0, "end time, s (0: from the waves to analyse at the last gauge)");
   o.snapshots = cli.get_number("snapshots", 20, "VTK snapshots per run (0: none)");
+  o.flow_map_from = cli.get_number(
+      "flow-map-from", -1,
+      "write flow_map.csv: the time-mean active fluid (counts per resolution, mass, volume, mass flux, the "
+      "refinement's "
+      "sources of active mass) in 2.5 mm bins over x 0.5 to 1.9 m, averaged from this time, s (< 0: no map)");
   std::string precision =
       cli.get("precision", "auto", "scalar type: float | double | auto (double for the rod, float otherwise)");
   o.out = cli.get("output", "out/posidonia_flume", "output folder");

@@ -1,0 +1,170 @@
+#!/usr/bin/python3
+"""Time-mean flow maps of posidonia_flume runs (flow_map.csv, --flow-map-from): where a refined run makes or loses
+active water, and how its mean mass flux differs from the uniformly fine run's.
+
+    /usr/bin/python3 examples/posidonia_flume/flow_map.py REFERENCE RUN [RUN ...] --labels fine,paired,... \\
+        --box 0.9,1.5,0.13 [--bin 0.01] [--plot map.png] [--csv regions.csv]
+
+Prints, per run, the active mass the refinement's passes created in regions around the box (status changes and the
+accounts, kg per m width and second), the flux of mass through the box's faces, and the mean horizontal mass flux
+(a transport velocity) in the box's lower and upper halves against the reference. Maps: the mean horizontal mass flux
+of each run, its difference from the reference, and the sources of active mass, over x 0.7 to 1.7 m.
+"""
+import argparse
+import sys
+
+import numpy as np
+
+
+def read_map(path):
+    rows = []
+    names = None
+    with open(path) as f:
+        for line in f:
+            if line.startswith('#'):
+                continue
+            if names is None:
+                names = line.strip().split(',')
+                continue
+            rows.append([float(v) for v in line.split(',')])
+    data = np.array(rows)
+    x, z = data[:, 0], data[:, 1]
+    xs, zs = np.unique(x), np.unique(z)
+    grid = {}
+    for j, name in enumerate(names):
+        g = np.zeros((len(xs), len(zs)))
+        g[np.searchsorted(xs, x), np.searchsorted(zs, z)] = data[:, j]
+        grid[name] = g
+    return xs, zs, grid
+
+
+def coarsen(xs, zs, grid, factor):
+    """Sums of `factor` x `factor` bins: counts and sources add, per-area means average."""
+    nx, nz = len(xs) // factor, len(zs) // factor
+    out = {}
+    for name, g in grid.items():
+        g = g[:nx * factor, :nz * factor].reshape(nx, factor, nz, factor)
+        if name == 'fine_mass_ratio':
+            w = grid['active_fine'][:nx * factor, :nz * factor].reshape(nx, factor, nz, factor)
+            s = w.sum(axis=(1, 3))
+            out[name] = np.where(s > 0, (g * w).sum(axis=(1, 3)) / np.maximum(s, 1e-300), 0)
+        elif name in ('x', 'z'):
+            out[name] = g.mean(axis=(1, 3))
+        elif name.startswith('active') or name.startswith('passive'):
+            out[name] = g.sum(axis=(1, 3))
+        else:
+            out[name] = g.mean(axis=(1, 3))
+    return out['x'][:, 0], out['z'][0, :], out
+
+
+def region_sum(xs, zs, field, bin_area, x0, x1, z0, z1):
+    """Integral of a per-area field over the bins whose centres lie in [x0, x1) x [z0, z1)."""
+    mx = (xs >= x0) & (xs < x1)
+    mz = (zs >= z0) & (zs < z1)
+    return field[np.ix_(mx, mz)].sum() * bin_area
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument('runs', nargs='+', help='run folders (the first is the reference); their plants/flow_map.csv')
+    ap.add_argument('--labels', default='', help='comma-separated labels')
+    ap.add_argument('--box', default='0.9,1.5,0.13', help='box x0,x1,top (m)')
+    ap.add_argument('--bin', type=float, default=0.01, help='bin of the maps and sums, m (a multiple of 2.5 mm)')
+    ap.add_argument('--plot', default='', help='PNG of the maps')
+    ap.add_argument('--csv', default='', help='CSV of the region sums')
+    a = ap.parse_args()
+    labels = a.labels.split(',') if a.labels else [r.rstrip('/').split('/')[-1] for r in a.runs]
+    if len(labels) != len(a.runs):
+        sys.exit('flow_map.py: --labels needs one label per run')
+    bx0, bx1, btop = (float(v) for v in a.box.split(','))
+    maps = []
+    for r in a.runs:
+        xs, zs, g = read_map(f'{r}/plants/flow_map.csv')
+        factor = max(1, int(round(a.bin / (xs[1] - xs[0]))))
+        maps.append(coarsen(xs, zs, g, factor))
+    bin_area = a.bin * a.bin
+    rows = []
+    half = btop / 2
+    regions = [
+        ('upstream corner (x0 +- 5 cm, below top/2)', bx0 - 0.05, bx0 + 0.05, 0, half),
+        ('upstream edge upper (x0 +- 5 cm, top/2 to top)', bx0 - 0.05, bx0 + 0.05, half, btop),
+        ('box interior lower', bx0 + 0.05, bx1 - 0.05, 0, half),
+        ('box interior upper', bx0 + 0.05, bx1 - 0.05, half, btop),
+        ('box top band (top +- 5 cm)', bx0 - 0.05, bx1 + 0.05, btop - 0.05, btop + 0.05),
+        ('downstream corner (x1 +- 5 cm, below top/2)', bx1 - 0.05, bx1 + 0.05, 0, half),
+        ('downstream edge upper (x1 +- 5 cm, top/2 to top)', bx1 - 0.05, bx1 + 0.05, half, btop),
+        ('everything', -1, 10, -1, 10),
+    ]
+    print('active mass created per second (kg/(m s)) by status changes / accounts / both:')
+    for (xs, zs, g), label in zip(maps, labels):
+        print(f'  {label}:')
+        for name, x0, x1, z0, z1 in regions:
+            s = region_sum(xs, zs, g['status_source'], bin_area, x0, x1, z0, z1)
+            c = region_sum(xs, zs, g['account_source'], bin_area, x0, x1, z0, z1)
+            print(f'    {name:48s} {s:+.4e} / {c:+.4e} / {s + c:+.4e}')
+            rows.append((label, name, s, c))
+    print('mean horizontal mass flux sum m u / (rho0 A), mm/s (averaged over the region):')
+    ref = maps[0]
+    for (xs, zs, g), label in zip(maps, labels):
+        out = []
+        for name, x0, x1, z0, z1 in regions[:7]:
+            area = region_sum(xs, zs, np.ones_like(g['flux_x']), bin_area, x0, x1, z0, z1)
+            out.append(region_sum(xs, zs, g['flux_x'], bin_area, x0, x1, z0, z1) / area * 1e3)
+        print(f'  {label:14s} ' + ' '.join(f'{v:+7.2f}' for v in out))
+    # the column transport below the box top: sum over z of flux_x dz, along x (m^2/s per m width)
+    print('mean transport below the box top, integral of flux_x over 0 < z < top, mm^2/s, at x =')
+    xs0 = maps[0][0]
+    probes = [bx0 - 0.1, bx0 - 0.03, bx0 + 0.03, bx0 + 0.1, 0.5 * (bx0 + bx1), bx1 - 0.1, bx1 - 0.03, bx1 + 0.03,
+              bx1 + 0.1]
+    print('  ' + ' '.join(f'{x:8.3f}' for x in probes))
+    for (xs, zs, g), label in zip(maps, labels):
+        vals = []
+        for x in probes:
+            i = int(np.argmin(np.abs(xs - x)))
+            mz = zs < btop
+            vals.append(g['flux_x'][i, mz].sum() * a.bin * 1e6)
+        print(f'  {label:14s}' + ' '.join(f'{v:+8.1f}' for v in vals))
+    print('mean transport over the whole depth (a source between two stations steps it), mm^2/s, at the same x:')
+    for (xs, zs, g), label in zip(maps, labels):
+        vals = [g['flux_x'][int(np.argmin(np.abs(xs - x))), :].sum() * a.bin * 1e6 for x in probes]
+        print(f'  {label:14s}' + ' '.join(f'{v:+8.1f}' for v in vals))
+    if a.csv:
+        with open(a.csv, 'w') as f:
+            f.write('# active mass created per second by the refinement passes in regions around the box '
+                    '(flow_map.py); kg/(m s)\n')
+            f.write('run,region,status_source,account_source\n')
+            for label, name, s, c in rows:
+                f.write(f'{label},"{name}",{s:.6e},{c:.6e}\n')
+    if a.plot:
+        import matplotlib
+        matplotlib.use('Agg')
+        import matplotlib.pyplot as plt
+        n = len(maps)
+        fig, axes = plt.subplots(n, 3, figsize=(15, 2.6 * n), squeeze=False, sharex=True, sharey=True)
+        for row, ((xs, zs, g), label) in enumerate(zip(maps, labels)):
+            mx = (xs > 0.7) & (xs < 1.7)
+            mz = zs < 0.2
+            ext = [xs[mx][0] - a.bin / 2, xs[mx][-1] + a.bin / 2, 0, zs[mz][-1] + a.bin / 2]
+            panels = [(g['flux_x'] * 1e3, f'{label}: mean mass flux u, mm/s', 30),
+                      ((g['flux_x'] - ref[2]['flux_x']) * 1e3, f'{label} - {labels[0]}, mm/s', 30),
+                      (g['status_source'] + g['account_source'], f'{label}: source of active mass, kg/(m^3 s)', None)]
+            for col, (field, title, lim) in enumerate(panels):
+                f = field[np.ix_(mx, mz)].T
+                if lim is None:
+                    lim = max(np.percentile(np.abs(f), 99.5), 1e-12)
+                im = axes[row, col].imshow(f, origin='lower', extent=ext, aspect='auto', cmap='RdBu_r', vmin=-lim,
+                                           vmax=lim)
+                axes[row, col].set_title(title, fontsize=9)
+                axes[row, col].add_patch(plt.Rectangle((bx0, 0), bx1 - bx0, btop, fill=False, ls='--', lw=0.8))
+                fig.colorbar(im, ax=axes[row, col], fraction=0.03)
+        for ax in axes[-1]:
+            ax.set_xlabel('x (m)')
+        for ax in axes[:, 0]:
+            ax.set_ylabel('z (m)')
+        fig.tight_layout()
+        fig.savefig(a.plot, dpi=110)
+        print(f'plot: {a.plot}')
+
+
+if __name__ == '__main__':
+    main()
