@@ -72,11 +72,29 @@ def main():
     ap.add_argument('--bin', type=float, default=0.01, help='bin of the maps and sums, m (a multiple of 2.5 mm)')
     ap.add_argument('--plot', default='', help='PNG of the maps')
     ap.add_argument('--csv', default='', help='CSV of the region sums')
+    ap.add_argument('--check-balance', type=float, default=0, metavar='TOL',
+                    help='exit 1 unless, in every run, the status and account sources summed over the map cancel to '
+                         'within TOL times the sum of the status sources\' magnitudes (a refined run with the mass '
+                         'account on conserves the active mass at every pass)')
     a = ap.parse_args()
     labels = a.labels.split(',') if a.labels else [r.rstrip('/').split('/')[-1] for r in a.runs]
     if len(labels) != len(a.runs):
         sys.exit('flow_map.py: --labels needs one label per run')
     bx0, bx1, btop = (float(v) for v in a.box.split(','))
+    if a.check_balance > 0:
+        failed = False
+        for r, label in zip(a.runs, labels):
+            xs, zs, g = read_map(f'{r}/plants/flow_map.csv')
+            area = (xs[1] - xs[0]) * (zs[1] - zs[0])
+            net = (g['status_source'] + g['account_source']).sum() * area
+            scale = np.abs(g['status_source']).sum() * area
+            ok = scale > 0 and abs(net) <= a.check_balance * scale
+            failed = failed or not ok
+            print(f'{label}: sources of active mass over the map: net {net:+.3e} kg/(m s), status changes\' magnitude '
+                  f'{scale:.3e} kg/(m s): ratio {abs(net) / scale if scale > 0 else float("nan"):.2e} '
+                  f'(tolerance {a.check_balance:g}) ' + ('PASS' if ok else 'FAIL' if scale > 0 else
+                                                        'FAIL (no status change recorded: nothing checked)'))
+        sys.exit(1 if failed else 0)
     maps = []
     for r in a.runs:
         xs, zs, g = read_map(f'{r}/plants/flow_map.csv')

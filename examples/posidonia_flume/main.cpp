@@ -287,6 +287,7 @@ scenes::PosidoniaFlume<T> converted(const scenes::PosidoniaFlume<double>& s) {
                   T(s.refinement.edge_dither),
                   s.refinement.wall_faces,
                   s.refinement.paired_statuses,
+                  s.refinement.paired_exchange,
                   s.refinement.account_over_all_fluid,
                   s.refinement.passive_mass_from_volume};
   return c;
@@ -584,6 +585,9 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
         "refinement: {} fluid particles at the end ({} active, {} passive, {} fine); {} children created, {} removed; "
         "largest mass-account correction {:.2e}, momentum-account velocity shift {:.2e} m/s\n",
         active + passive, active, passive, fine, c.created, c.removed, c.mass_correction, c.momentum_correction);
+    if (scene.refinement.paired_exchange)
+      fmt::print("refinement: paired exchange in {} groups, {} groups left to the accounts\n", c.exchanged,
+                 c.exchange_skipped);
     const auto box = scene.refinement_boxes().front();
     if (scene.refinement.follow_flow)
       fmt::print("refinement: the box moved {:.4f} m along x with the water\n",
@@ -1075,6 +1079,10 @@ int main(int argc, char** argv) try {
       "paired-statuses", false,
       "refinement: a fine particle near a box edge is active exactly when the nearest coarse one is passive, so the "
       "water changes hands cell by cell (off: each particle's status follows its own position): on | off");
+  s.refinement.paired_exchange = cli.get_switch(
+      "paired-exchange", false,
+      "refinement, with --paired-statuses on: a coarse particle and its paired fine ones exchange mass and momentum as "
+      "they change status (off: the activated particles keep their passive masses and the accounts balance): on | off");
   const std::string account_region = cli.get(
       "account-region", "edges",
       "refinement: the accounts hand their changes to the active particles near the box edges (edges) or to all "

@@ -170,6 +170,16 @@ struct AdaptiveRefinementParameters {
   /// active mass no longer swings by whole columns of one level (docs/variable-resolution.md, session 33). Statuses
   /// are decided level by level, coarse first. 0 / false: every particle's status follows its own position.
   bool paired_statuses{false};
+  /// With paired_statuses: whether a coarse particle and the finer particles paired with it that change status the
+  /// other way in the same pass exchange their mass and momentum (paired exchange): a coarse particle that becomes
+  /// active takes the mass and mean velocity of its paired fine particles that become passive; fine particles that
+  /// become active as their coarse one becomes passive are scaled to its mass and shifted to its velocity. The water
+  /// then changes hands without a local source of mass or momentum; the accounts take only what unpaired changes left.
+  /// A group whose fine mass is outside [1/2, 2] times the coarse one's is left to the accounts. Without it a status
+  /// change brings in the passive particles' volume-based masses, and the accounts hand the difference to the whole
+  /// band near the box edges: measured, a pump that drives a mean vertical circulation through the box's top face
+  /// (docs/variable-resolution.md, session 34).
+  bool paired_exchange{false};
   /// Whether the statuses populate() gave are carried by the particles from then on (Lagrangian statuses): after
   /// populate() a pass changes no status, creates no child and removes no particle; it only fits the passive
   /// particles' values. The refined region is then a patch of water that moves with the flow (the particles of each
@@ -224,6 +234,11 @@ struct AdaptiveRefinementParameters {
     require_in_range("AdaptiveRefinementParameters::mass_account_relaxation (tau, s)", mass_account_relaxation, T(0),
                      T(1e6));
     require_in_range("AdaptiveRefinementParameters::distant_fit_interval (s)", distant_fit_interval, T(0), T(1));
+    if (paired_exchange && !paired_statuses)
+      throw InputError(
+          "AdaptiveRefinementParameters::paired_exchange = true needs paired_statuses = true (the exchange is between "
+          "a "
+          "coarse particle and the fine particles paired with it)");
     if (distant_fit_interval > T(0) && (lagrangian_statuses || boxes_follow_flow))
       throw InputError(
           "AdaptiveRefinementParameters::distant_fit_interval > 0 needs fixed boxes and statuses that follow them "
@@ -258,6 +273,11 @@ struct AdaptiveRefinementCounts {
   /// count's (diagnostics of where the active mass moves, docs/variable-resolution.md, session 30).
   std::array<double, 9> status_mass{};
   std::array<double, 9> status_nominal_mass{};
+  /// Paired exchange (AdaptiveRefinementParameters::paired_exchange): coarse particles that exchanged mass and momentum
+  /// with their paired fine particles in the pass, and the groups left to the accounts (fine mass outside [1/2, 2] of
+  /// the coarse one's).
+  std::size_t exchanged{0};
+  std::size_t exchange_skipped{0};
 };
 
 /// Adaptive particle refinement with overlapping resolutions (see the header comment). A ParticleModel: it adds no
@@ -481,6 +501,8 @@ class AdaptiveRefinement {
     total_.activated += c.activated;
     total_.deactivated += c.deactivated;
     total_.uninterpolated += c.uninterpolated;
+    total_.exchanged += c.exchanged;
+    total_.exchange_skipped += c.exchange_skipped;
     total_.mass_correction = std::max(total_.mass_correction, c.mass_correction);
     total_.momentum_correction = std::max(total_.momentum_correction, c.momentum_correction);
     total_.pending_mass = std::max(total_.pending_mass, c.pending_mass);
@@ -547,6 +569,7 @@ class AdaptiveRefinement {
   void pair_statuses(System& system) {
     const auto& p = system.particles();
     const int top = max_box_level();
+    partner_.assign(p.size(), p.size());
     for (int k = 1; k <= top; ++k) {
       parallel_for(p.size(), [&](std::size_t a) {
         if (p.kind[a] != Kind::fluid || leaving_[a] || level_[a] != k || !near_box_edge(p.position[a])) return;
@@ -562,7 +585,54 @@ class AdaptiveRefinement {
                                            }
                                          });
         if (coarse < p.size()) status_[a] = status_[coarse] ? 0 : 1;
+        partner_[a] = coarse;
       });
+    }
+  }
+
+  // Paired exchange (AdaptiveRefinementParameters::paired_exchange), before the new statuses are applied: each coarse
+  // particle c whose status changes and the particles paired with it (partner_) whose status changes the other way
+  // form a group. c becoming active takes the group's fine mass and mean velocity; c becoming passive scales its
+  // fine particles to its mass and shifts them to its velocity. Mass and momentum of the active fluid then do not
+  // change with the group's statuses (to round-off). Groups with a fine mass outside [1/2, 2] m_c are left as they are.
+  void exchange_paired(System& system, AdaptiveRefinementCounts& counts) {
+    auto& p = system.particles();
+    const std::size_t n = p.size();
+    auto flips = [&](std::size_t a) { return p.kind[a] == Kind::fluid && !leaving_[a] && status_[a] != p.passive[a]; };
+    auto member = [&](std::size_t a) {
+      const std::size_t c = partner_[a];
+      return c < n && flips(a) && flips(c) && status_[a] != status_[c];
+    };
+    group_mass_.assign(n, T(0));
+    group_momentum_.assign(n, Vector::Zero());
+    for (std::size_t a = 0; a < n; ++a) {
+      if (!member(a)) continue;
+      group_mass_[partner_[a]] += p.mass[a];
+      group_momentum_[partner_[a]] += p.mass[a] * p.velocity[a];
+    }
+    for (std::size_t c = 0; c < n; ++c) {
+      const T fine = group_mass_[c];
+      if (!(fine > T(0))) continue;
+      if (!(fine >= T(0.5) * p.mass[c] && fine <= T(2) * p.mass[c])) {
+        group_mass_[c] = T(0);  // left to the accounts
+        ++counts.exchange_skipped;
+        continue;
+      }
+      ++counts.exchanged;
+      const Vector mean_velocity = group_momentum_[c] / fine;
+      if (status_[c] == 0) {  // c becomes active, its fine particles passive
+        p.mass[c] = fine;
+        p.velocity[c] = mean_velocity;
+        group_mass_[c] = T(0);
+      } else {  // c becomes passive, its fine particles active: scale factor and velocity shift for them
+        group_mass_[c] = p.mass[c] / fine;
+        group_momentum_[c] = p.velocity[c] - mean_velocity;
+      }
+    }
+    for (std::size_t a = 0; a < n; ++a) {
+      if (!member(a) || !(group_mass_[partner_[a]] > T(0))) continue;
+      p.mass[a] *= group_mass_[partner_[a]];
+      p.velocity[a] += group_momentum_[partner_[a]];
     }
   }
 
@@ -618,6 +688,7 @@ class AdaptiveRefinement {
       status_[a] = passive;
     }
     if (params_.paired_statuses && initial_level < 0) pair_statuses(system);
+    if (params_.paired_exchange && initial_level < 0) exchange_paired(system, counts);
     for (std::size_t a = 0; a < n; ++a) {
       if (p.kind[a] != Kind::fluid || leaving_[a]) continue;
       const int k = level_[a];
@@ -918,6 +989,9 @@ class AdaptiveRefinement {
   std::vector<std::uint8_t> missing_;        // per slot: passive without an active neighbour of another level
   std::vector<std::uint8_t> leaving_;        // per slot of the pass: 1 if removed in it
   std::vector<std::uint8_t> status_;         // per slot of the pass: the new passive flag
+  std::vector<std::size_t> partner_;         // per slot (paired statuses): the coarser particle paired with it, or n
+  std::vector<T> group_mass_;                // per slot (paired exchange): fine mass of its group, then a scale
+  std::vector<Vector> group_momentum_;       // per slot (paired exchange): fine momentum of its group, then a shift
   T lattice_number_density_{1};              // lattice_number_density() of the kernel (populate)
   std::vector<std::size_t> removals_;        // slots to remove
   std::vector<Child> created_;               // children to create

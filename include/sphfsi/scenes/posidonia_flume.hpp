@@ -99,6 +99,9 @@ struct PlantRefinement {
   /// AdaptiveRefinementParameters::paired_statuses: a fine particle near a box edge takes the opposite status of the
   /// nearest coarse one, so a coarse particle and the fine ones of its cell change status together
   bool paired_statuses{false};
+  /// AdaptiveRefinementParameters::paired_exchange: with paired_statuses, a coarse particle and its paired fine ones
+  /// exchange mass and momentum as they change status
+  bool paired_exchange{false};
   /// AdaptiveRefinementParameters::account_over_all_fluid: the accounts hand their changes to all active fluid
   bool account_over_all_fluid{false};
   /// AdaptiveRefinementParameters::passive_mass_from_volume: passive masses from their SPH volume (else nominal)
@@ -238,6 +241,7 @@ struct PosidoniaFlume {
     a.distant_fit_interval = refinement.distant_fit_interval;
     a.edge_dither = refinement.edge_dither;
     a.paired_statuses = refinement.paired_statuses;
+    a.paired_exchange = refinement.paired_exchange;
     a.account_over_all_fluid = refinement.account_over_all_fluid;
     a.passive_mass_from_volume = refinement.passive_mass_from_volume;
     return a;
