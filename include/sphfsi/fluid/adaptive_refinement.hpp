@@ -48,7 +48,10 @@
 //
 // Paired statuses (paired_statuses): near a box edge a finer particle is active exactly when the nearest particle of
 // the next coarser level is passive, so a coarse particle and the fine particles of its cell change status together
-// and the water changes hands cell by cell, not column by column.
+// and the water changes hands cell by cell, not column by column. With paired_exchange the group of a coarse particle
+// and its paired fine ones that change status the other way also hand over their mass and momentum (the coarse one
+// takes the fine ones' mass and mean velocity, or they are scaled to its mass and shifted to its velocity), so a
+// status change is no local source of either and the accounts keep only what unpaired changes leave.
 //
 // Boxes that follow the flow (boxes_follow_flow): the boxes move along x with the mean velocity of the finest active
 // fluid in them, so that a wave's orbital motion carries the edges with the water.
