@@ -1158,6 +1158,35 @@ TEST_CASE("adaptive refinement: status hysteresis stops particles oscillating ac
   CHECK_THROWS_WITH(bad.validate(), Catch::Contains("status_hysteresis"));
 }
 
+// The drifting lattice of the edge tests: 40 x 40 particles at dp with the velocity field v(x) (no forces, no
+// accounts), and a level-1 box that spans 32 rows from x = 8 dp and reaches past the block's right end; each pass moves
+// the lattice 0.05 dp along x, so it crosses the box's left edge only.
+struct DriftingLattice {
+  static constexpr double dp = 0.01;
+  AprSystem system{Domain<2, double>(V2(-0.1, -0.1), V2(0.7, 0.5)), Tait<double>(1000, 20)};
+  AdaptiveRefinementParameters<double> params;
+  template <class Velocity>
+  explicit DriftingLattice(Velocity&& velocity) {
+    for (int i = 0; i < 40; ++i)
+      for (int j = 0; j < 40; ++j) {
+        const V2 x((i + 0.5) * dp, (j + 0.5) * dp);
+        system.particles().add(Kind::fluid, x, velocity(x), 1000, 1000 * dp * dp, 1.3 * dp);
+      }
+    system.update_pressure();
+    params.base_spacing = dp;
+    params.transition_width = 4 * dp;
+    params.conserve_mass = false;
+    params.conserve_momentum = false;
+  }
+  Apr refinement() const { return Apr(system.domain(), {{V2(8 * dp, 4 * dp), V2(0.55, 36 * dp), 1}}, params); }
+  void drift(Apr& apr, int pass) {
+    auto& p = system.particles();
+    for (std::size_t i = 0; i < p.size(); ++i) p.position[i][0] += 0.05 * dp;
+    system.update_neighbors(pass * 1e-3);
+    apr.advance(system, pass * 1e-3, 1e-3);
+  }
+};
+
 // Dithered box edges (AdaptiveRefinementParameters::edge_dither). A 40 x 40 lattice at dp (no forces, no accounts)
 // drifts 4 dp along x, 0.05 dp per pass, across the left edge of a level-1 box that spans 32 rows (the box reaches past
 // the block's right end, so no other edge is crossed). Without dither each lattice column changes status at once: the
@@ -1169,32 +1198,19 @@ TEST_CASE("adaptive refinement: status hysteresis stops particles oscillating ac
 // particles of a quarter of the mass in the band).
 TEST_CASE("adaptive refinement: dithered box edges let a lattice column change status particle by particle",
           "[refinement][apr]") {
-  constexpr double dp = 0.01;
+  constexpr double dp = DriftingLattice::dp;
   auto drift = [&](double dither, bool paired) {
-    AprSystem system{Domain<2, double>(V2(-0.1, -0.1), V2(0.7, 0.5)), Tait<double>(1000, 20)};
-    for (int i = 0; i < 40; ++i)
-      for (int j = 0; j < 40; ++j)
-        system.particles().add(Kind::fluid, V2((i + 0.5) * dp, (j + 0.5) * dp), V2::Zero(), 1000, 1000 * dp * dp,
-                               1.3 * dp);
-    system.update_pressure();
-    AdaptiveRefinementParameters<double> params;
-    params.base_spacing = dp;
-    params.transition_width = 4 * dp;
-    params.conserve_mass = false;
-    params.conserve_momentum = false;
-    params.edge_dither = dither;
-    params.paired_statuses = paired;
-    Apr apr(system.domain(), {{V2(8 * dp, 4 * dp), V2(0.55, 36 * dp), 1}}, params);
-    apr.populate(system);
-    auto& p = system.particles();
-    const double mass0 = apr.active_mass_momentum(system).first, column = 32 * 1000 * dp * dp;
+    DriftingLattice lattice([](const V2&) { return V2::Zero().eval(); });
+    lattice.params.edge_dither = dither;
+    lattice.params.paired_statuses = paired;
+    Apr apr = lattice.refinement();
+    apr.populate(lattice.system);
+    const double mass0 = apr.active_mass_momentum(lattice.system).first, column = 32 * 1000 * dp * dp;
     double worst = 0, sum2 = 0;
     constexpr int passes = 80;
     for (int pass = 0; pass < passes; ++pass) {
-      for (std::size_t i = 0; i < p.size(); ++i) p.position[i][0] += 0.05 * dp;
-      system.update_neighbors(pass * 1e-3);
-      apr.advance(system, pass * 1e-3, 1e-3);
-      const double change = (apr.active_mass_momentum(system).first - mass0) / column;
+      lattice.drift(apr, pass);
+      const double change = (apr.active_mass_momentum(lattice.system).first - mass0) / column;
       worst = std::max(worst, std::abs(change));
       sum2 += change * change;
     }
@@ -1239,35 +1255,22 @@ TEST_CASE("adaptive refinement: dithered box edges let a lattice column change s
 // and momentum by the mismatch; with it each group hands over its own, so both stay at their start values to
 // round-off. The passive particles' masses and velocities are refitted at every pass, so the mismatch is renewed.
 TEST_CASE("adaptive refinement: paired exchange hands mass and momentum over within each cell", "[refinement][apr]") {
-  constexpr double dp = 0.01;
+  constexpr double dp = DriftingLattice::dp;
   auto drift = [&](bool exchange) {
-    AprSystem system{Domain<2, double>(V2(-0.1, -0.1), V2(0.7, 0.5)), Tait<double>(1000, 20)};
-    for (int i = 0; i < 40; ++i)
-      for (int j = 0; j < 40; ++j) {
-        const V2 x((i + 0.5) * dp, (j + 0.5) * dp);
-        system.particles().add(Kind::fluid, x, V2(0.1 + 0.5 * x[1], 0.2 * x[0]), 1000, 1000 * dp * dp, 1.3 * dp);
-      }
-    system.update_pressure();
-    AdaptiveRefinementParameters<double> params;
-    params.base_spacing = dp;
-    params.transition_width = 4 * dp;
-    params.conserve_mass = false;
-    params.conserve_momentum = false;
-    params.paired_statuses = true;
-    params.paired_exchange = exchange;
-    Apr apr(system.domain(), {{V2(8 * dp, 4 * dp), V2(0.55, 36 * dp), 1}}, params);
-    apr.populate(system);
-    auto& p = system.particles();
+    DriftingLattice lattice([](const V2& x) { return V2(0.1 + 0.5 * x[1], 0.2 * x[0]); });
+    lattice.params.paired_statuses = true;
+    lattice.params.paired_exchange = exchange;
+    Apr apr = lattice.refinement();
+    apr.populate(lattice.system);
+    auto& p = lattice.system.particles();
     for (std::size_t i = 0; i < p.size(); ++i)
       if (p.kind[i] == Kind::fluid && !p.passive[i]) p.mass[i] *= 0.9 + 0.2 * double((p.id[i] * 7919u) % 101u) / 100;
-    const auto [mass0, momentum0] = apr.active_mass_momentum(system);
+    const auto [mass0, momentum0] = apr.active_mass_momentum(lattice.system);
     double worst_mass = 0, worst_momentum = 0;
     std::size_t exchanged = 0, skipped = 0;
     for (int pass = 0; pass < 80; ++pass) {
-      for (std::size_t i = 0; i < p.size(); ++i) p.position[i][0] += 0.05 * dp;
-      system.update_neighbors(pass * 1e-3);
-      apr.advance(system, pass * 1e-3, 1e-3);
-      const auto [mass, momentum] = apr.active_mass_momentum(system);
+      lattice.drift(apr, pass);
+      const auto [mass, momentum] = apr.active_mass_momentum(lattice.system);
       worst_mass = std::max(worst_mass, std::abs(mass - mass0) / mass0);
       worst_momentum = std::max(worst_momentum, (momentum - momentum0).norm() / momentum0.norm());
       exchanged += apr.last_counts().exchanged;
