@@ -178,10 +178,10 @@ struct AdaptiveRefinementParameters {
   /// active takes the mass and mean velocity of its paired fine particles that become passive; fine particles that
   /// become active as their coarse one becomes passive are scaled to its mass and shifted to its velocity. The water
   /// then changes hands without a local source of mass or momentum; the accounts take only what unpaired changes left.
-  /// A group whose fine mass is outside [1/2, 2] times the coarse one's is left to the accounts. Without it a status
-  /// change brings in the passive particles' volume-based masses, and the accounts hand the difference to the whole
-  /// band near the box edges: measured, a pump that drives a mean vertical circulation through the box's top face
-  /// (docs/variable-resolution.md, session 34).
+  /// A group whose fine mass is outside [1/2, 2] times the coarse one's is left to the accounts. Measured in the
+  /// refined Posidonia flume it makes the box much worse (a blow-up; H off by up to 20 %): a coarse particle's cell
+  /// holds 0.5-2 times its share of fine particles where the passive coarse ones have drifted, so the mass it takes
+  /// does not fit its place (docs/variable-resolution.md, session 34). Kept, off by default, for that measurement.
   bool paired_exchange{false};
   /// Whether the statuses populate() gave are carried by the particles from then on (Lagrangian statuses): after
   /// populate() a pass changes no status, creates no child and removes no particle; it only fits the passive
@@ -240,8 +240,7 @@ struct AdaptiveRefinementParameters {
     if (paired_exchange && !paired_statuses)
       throw InputError(
           "AdaptiveRefinementParameters::paired_exchange = true needs paired_statuses = true (the exchange is between "
-          "a "
-          "coarse particle and the fine particles paired with it)");
+          "a coarse particle and the fine particles paired with it)");
     if (distant_fit_interval > T(0) && (lagrangian_statuses || boxes_follow_flow))
       throw InputError(
           "AdaptiveRefinementParameters::distant_fit_interval > 0 needs fixed boxes and statuses that follow them "
