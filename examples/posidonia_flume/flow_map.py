@@ -103,14 +103,16 @@ def main():
     bin_area = a.bin * a.bin
     rows = []
     half = btop / 2
+    # disjoint regions (the last is the whole map): the top band takes the box's top face, the columns its sides
+    band = min(0.05, half)
     regions = [
         ('upstream corner (x0 +- 5 cm, below top/2)', bx0 - 0.05, bx0 + 0.05, 0, half),
-        ('upstream edge upper (x0 +- 5 cm, top/2 to top)', bx0 - 0.05, bx0 + 0.05, half, btop),
+        ('upstream edge upper (x0 +- 5 cm, top/2 to top - 5 cm)', bx0 - 0.05, bx0 + 0.05, half, btop - band),
         ('box interior lower', bx0 + 0.05, bx1 - 0.05, 0, half),
-        ('box interior upper', bx0 + 0.05, bx1 - 0.05, half, btop),
-        ('box top band (top +- 5 cm)', bx0 - 0.05, bx1 + 0.05, btop - 0.05, btop + 0.05),
+        ('box interior upper (to top - 5 cm)', bx0 + 0.05, bx1 - 0.05, half, btop - band),
+        ('box top band (top +- 5 cm)', bx0 - 0.05, bx1 + 0.05, btop - band, btop + band),
         ('downstream corner (x1 +- 5 cm, below top/2)', bx1 - 0.05, bx1 + 0.05, 0, half),
-        ('downstream edge upper (x1 +- 5 cm, top/2 to top)', bx1 - 0.05, bx1 + 0.05, half, btop),
+        ('downstream edge upper (x1 +- 5 cm, top/2 to top - 5 cm)', bx1 - 0.05, bx1 + 0.05, half, btop - band),
         ('everything', -1, 10, -1, 10),
     ]
     print('active mass created per second (kg/(m s)) by status changes / accounts / both:')
