@@ -172,7 +172,8 @@ class FlowMap {
       if (p.kind[a] != Kind::fluid) continue;
       const std::size_t b = bin_of(p.position[a]);
       if (b == npos) continue;
-      const bool fine = level_of(double(p.smoothing_length[a])) > 0;
+      const int level = level_of(double(p.smoothing_length[a]));
+      const bool fine = level > 0;
       double* c = &sums_[b * fields];
       if (p.passive[a]) {
         c[fine ? passive_fine : passive_coarse] += 1;
@@ -184,7 +185,7 @@ class FlowMap {
       c[volume] += m / double(p.density[a]);
       c[flux_x] += m * double(p.velocity[a][0]);
       c[flux_z] += m * double(p.velocity[a][1]);
-      if (fine) c[fine_mass_ratio] += m / nominal_mass(level_of(double(p.smoothing_length[a])));
+      if (fine) c[fine_mass_ratio] += m / nominal_mass(level);
     }
     ++samples_;
   }
@@ -437,12 +438,13 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
   io::CsvWriter currents_csv(dir / "currents.csv", current_columns,
                              "Eulerian horizontal velocity (m/s) of the active fluid at x (m, first number) and height "
                              "above the bed (m, second number)");
-  // the period-mean map of the active fluid (--flow-map-from): from 0.4 m before the first gauge past the paddle's
-  // ramp to the absorber, up to above the crests, in bins of half the fine spacing (dp / 2 of the refined runs)
+  // the period-mean map of the active fluid (--flow-map-from): over the current probes' span along x, up to above the
+  // crests, in bins of half the fine spacing of the refined runs (2.5 mm)
   std::optional<FlowMap<System>> flow_map;
   if (o.flow_map_from >= 0)
-    flow_map.emplace(0.5, 1.9, 1.3 * double(scene.depth), 0.0025, double(system.eos().reference_density()),
-                     double(g.smoothing_ratio * scene.dp()), double(scene.dp()));
+    flow_map.emplace(current_x.front(), current_x.back(), 1.3 * double(scene.depth), 0.0025,
+                     double(system.eos().reference_density()), double(g.smoothing_ratio * scene.dp()),
+                     double(scene.dp()));
   // the active fluid's volume sum m / rho and mass, per unit width: a refinement box's status changes move water
   // between the active and the passive fluid, and its mass account hands the difference back at fixed density
   io::CsvWriter volume_csv(
@@ -1026,8 +1028,8 @@ int main(int argc, char** argv) try {
   o.flow_map_from = cli.get_number(
       "flow-map-from", -1,
       "write flow_map.csv: the time-mean active fluid (counts per resolution, mass, volume, mass flux, the "
-      "refinement's "
-      "sources of active mass) in 2.5 mm bins over x 0.5 to 1.9 m, averaged from this time, s (< 0: no map)");
+      "refinement's sources of active mass) in 2.5 mm bins over x 0.5 to 1.9 m, averaged from this time, s (< 0: "
+      "no map)");
   std::string precision =
       cli.get("precision", "auto", "scalar type: float | double | auto (double for the rod, float otherwise)");
   o.out = cli.get("output", "out/posidonia_flume", "output folder");
