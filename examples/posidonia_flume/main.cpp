@@ -289,6 +289,7 @@ scenes::PosidoniaFlume<T> converted(const scenes::PosidoniaFlume<double>& s) {
                   s.refinement.wall_faces,
                   s.refinement.paired_statuses,
                   s.refinement.paired_exchange,
+                  T(s.refinement.activated_mass_bound),
                   s.refinement.account_over_all_fluid,
                   s.refinement.passive_mass_from_volume};
   return c;
@@ -1085,6 +1086,10 @@ int main(int argc, char** argv) try {
       "paired-exchange", false,
       "refinement, with --paired-statuses on: a coarse particle and its paired fine ones exchange mass and momentum as "
       "they change status (off: the activated particles keep their passive masses and the accounts balance): on | off");
+  s.refinement.activated_mass_bound = cli.get_number(
+      "activated-account", 0,
+      "refinement: the mass account hands a pass's change first to the particles that became active in it, each "
+      "within this fraction of its nominal mass, [0, 1) (0: off, all to the particles near the box edges)");
   const std::string account_region = cli.get(
       "account-region", "edges",
       "refinement: the accounts hand their changes to the active particles near the box edges (edges) or to all "

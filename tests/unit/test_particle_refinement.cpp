@@ -12,6 +12,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <random>
 #include <set>
 
@@ -1297,6 +1298,72 @@ TEST_CASE("adaptive refinement: paired exchange hands mass and momentum over wit
   bad.transition_width = 4 * dp;
   bad.paired_exchange = true;  // without paired statuses
   CHECK_THROWS_WITH(bad.validate(), Catch::Contains("paired_exchange"));
+}
+
+// The activated account (AdaptiveRefinementParameters::activated_mass_bound). The lattice of the paired-exchange case
+// (paired statuses, active masses spread by +-10 %) drifts 4 dp across the box's left edge with the mass account on.
+// The account of the edge band (bound 0) rescales every active particle within transition_width of the edge at each
+// pass that changed the active mass. With the bound 0.2 the change goes to the particles that became active in the
+// pass, each held within +-20 % of its nominal mass: the mismatch of a pass is a fraction of the activated mass of
+// the order of the +-10 % spread, so it fits and the particles that stay active keep their masses exactly. Either way
+// the active mass is conserved to round-off.
+TEST_CASE("adaptive refinement: the activated account hands a status change's mass to the particles that took over",
+          "[refinement][apr]") {
+  constexpr double dp = DriftingLattice::dp;
+  auto drift = [&](double bound) {
+    DriftingLattice lattice([](const V2& x) { return V2(0.1 + 0.5 * x[1], 0.2 * x[0]); });
+    lattice.params.paired_statuses = true;
+    lattice.params.conserve_mass = true;
+    lattice.params.activated_mass_bound = bound;
+    Apr apr = lattice.refinement();
+    apr.populate(lattice.system);
+    auto& p = lattice.system.particles();
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (p.kind[i] == Kind::fluid && !p.passive[i]) p.mass[i] *= 0.9 + 0.2 * double((p.id[i] * 7919u) % 101u) / 100;
+    const double mass0 = apr.active_mass_momentum(lattice.system).first;
+    double worst_mass = 0, worst_stayed = 0, worst_nominal = 0;
+    std::size_t activated = 0;
+    for (int pass = 0; pass < 80; ++pass) {
+      std::map<std::uint32_t, double> active_before;
+      for (std::size_t i = 0; i < p.size(); ++i)
+        if (p.kind[i] == Kind::fluid && !p.passive[i]) active_before[p.id[i]] = p.mass[i];
+      lattice.drift(apr, pass);
+      worst_mass = std::max(worst_mass, std::abs(apr.active_mass_momentum(lattice.system).first - mass0) / mass0);
+      activated += apr.last_counts().activated;
+      for (std::size_t i = 0; i < p.size(); ++i) {
+        if (p.kind[i] != Kind::fluid || p.passive[i]) continue;
+        const double nominal = 1000 * std::pow(dp * p.smoothing_length[i] / (1.3 * dp), 2);
+        worst_nominal = std::max(worst_nominal, std::abs(p.mass[i] / nominal - 1));
+        if (const auto it = active_before.find(p.id[i]); it != active_before.end())
+          worst_stayed = std::max(worst_stayed, std::abs(p.mass[i] / it->second - 1));
+      }
+    }
+    return std::tuple{worst_mass, worst_stayed, worst_nominal, activated};
+  };
+  const auto [mass_band, stayed_band, nominal_band, activated_band] = drift(0);
+  const auto [mass_bounded, stayed_bounded, nominal_bounded, activated_bounded] = drift(0.2);
+  INFO(
+      "relative change of the active mass / largest mass change of a particle that stayed active / largest deviation "
+      "from nominal: edge band "
+      << mass_band << " / " << stayed_band << " / " << nominal_band << " (" << activated_band
+      << " activated); activated account " << mass_bounded << " / " << stayed_bounded << " / " << nominal_bounded
+      << " (" << activated_bounded << " activated)");
+  CHECK(activated_bounded >= 32 * 4);  // every coarse particle of the 32-row column, in each of the 4 columns crossed
+  CHECK(mass_band <= 1e-13);
+  CHECK(mass_bounded <= 1e-13);
+  CHECK(stayed_band > 1e-6);   // the band is rescaled
+  CHECK(stayed_bounded == 0);  // the particles that stayed active are left alone
+  CHECK(nominal_bounded <= 0.2 + 1e-12);
+
+  AdaptiveRefinementParameters<double> bad;
+  bad.base_spacing = dp;
+  bad.transition_width = 4 * dp;
+  bad.activated_mass_bound = 1;
+  CHECK_THROWS_WITH(bad.validate(), Catch::Contains("activated_mass_bound") && Catch::Contains("[0, 1)"));
+  bad.activated_mass_bound = 0.2;
+  CHECK_NOTHROW(bad.validate());
+  bad.conserve_mass = false;
+  CHECK_THROWS_WITH(bad.validate(), Catch::Contains("conserve_mass"));
 }
 
 // Wall faces (RefinementBox::wall_faces): a box standing on the bottom of the block (its lower face at y = 0, where no

@@ -183,6 +183,14 @@ struct AdaptiveRefinementParameters {
   /// holds 0.5-2 times its share of fine particles where the passive coarse ones have drifted, so the mass it takes
   /// does not fit its place (docs/variable-resolution.md, session 34). Kept, off by default, for that measurement.
   bool paired_exchange{false};
+  /// Bound r of the activated account, [0, 1): with r > 0 the mass account hands the mass a pass changed first to the
+  /// particles that became active in it (the water that changed hands: a status change that loses active mass is a
+  /// coarse particle taking over, with its capped passive mass, the water its fine ones leave), in proportion to
+  /// their masses, each held within [1 - r, 1 + r] times the nominal mass of its level (a mass that is already
+  /// outside is not moved further out); only what does not fit goes to the particles near the box edges. Session 29's
+  /// account to every active particle within a kernel support blew up (heavy and light particles at the edge); here
+  /// the mass goes only to the particles that take over the water, and stays tied to their nominal volume. 0: off.
+  T activated_mass_bound{0};
   /// Whether the statuses populate() gave are carried by the particles from then on (Lagrangian statuses): after
   /// populate() a pass changes no status, creates no child and removes no particle; it only fits the passive
   /// particles' values. The refined region is then a patch of water that moves with the flow (the particles of each
@@ -237,6 +245,15 @@ struct AdaptiveRefinementParameters {
     require_in_range("AdaptiveRefinementParameters::mass_account_relaxation (tau, s)", mass_account_relaxation, T(0),
                      T(1e6));
     require_in_range("AdaptiveRefinementParameters::distant_fit_interval (s)", distant_fit_interval, T(0), T(1));
+    if (!(activated_mass_bound >= T(0) && activated_mass_bound < T(1)))
+      throw InputError(
+          fmt::format("AdaptiveRefinementParameters::activated_mass_bound = {} is invalid: valid range is "
+                      "[0, 1) (a fraction of the nominal mass; 0: off)",
+                      activated_mass_bound));
+    if (activated_mass_bound > T(0) && !conserve_mass)
+      throw InputError(
+          "AdaptiveRefinementParameters::activated_mass_bound > 0 needs conserve_mass = true (it is a form of the "
+          "mass account)");
     if (paired_exchange && !paired_statuses)
       throw InputError(
           "AdaptiveRefinementParameters::paired_exchange = true needs paired_statuses = true (the exchange is between "
@@ -537,6 +554,8 @@ class AdaptiveRefinement {
       counts.pending_mass = std::abs(static_cast<double>(pending_mass_ / mass));
     }
     Vector momentum_change = before.second - momentum;
+    if (mass_change != T(0) && params_.activated_mass_bound > T(0))
+      mass_change = account_to_activated(system, mass_change, momentum_change);
     if (mass_change == T(0) && (!params_.conserve_momentum || momentum_change.squaredNorm() == T(0))) return;
     edge_.clear();
     T band = T(0);
@@ -563,6 +582,37 @@ class AdaptiveRefinement {
     const Vector shift = momentum_change / band;
     for (std::size_t a : edge_) p.velocity[a] += shift;
     counts.momentum_correction = static_cast<double>(shift.norm());
+  }
+
+  // The activated account (AdaptiveRefinementParameters::activated_mass_bound = r): the mass change dM goes to the
+  // particles that became active in this pass (activated_id_), shares m_a dM / M_activated, each new mass held within
+  // [min(m_a, (1 - r) m_nom), max(m_a, (1 + r) m_nom)] (m_nom the nominal mass of its level); the momentum the
+  // rescaling carries is taken off momentum_change. Returns the part of dM that did not fit.
+  T account_to_activated(System& system, T mass_change, Vector& momentum_change) {
+    auto& p = system.particles();
+    if (activated_id_.empty()) return mass_change;
+    std::sort(activated_id_.begin(), activated_id_.end());
+    activated_.clear();
+    T activated_mass = T(0);
+    for (std::size_t a = 0; a < p.size(); ++a) {
+      if (p.kind[a] != Kind::fluid || p.passive[a]) continue;
+      if (!std::binary_search(activated_id_.begin(), activated_id_.end(), p.id[a])) continue;
+      activated_.push_back(a);
+      activated_mass += p.mass[a];
+    }
+    if (!(activated_mass > T(0))) return mass_change;
+    const T share = mass_change / activated_mass, rho0 = system.eos().reference_density();
+    T handed = T(0);
+    for (std::size_t a : activated_) {
+      const T nominal = nominal_mass(level_of_particle(p, a), rho0);
+      const T lowest = std::min(p.mass[a], (T(1) - params_.activated_mass_bound) * nominal);
+      const T highest = std::max(p.mass[a], (T(1) + params_.activated_mass_bound) * nominal);
+      const T change = std::clamp(p.mass[a] * (T(1) + share), lowest, highest) - p.mass[a];
+      momentum_change -= change * p.velocity[a];  // the rescaling's momentum
+      p.mass[a] += change;
+      handed += change;
+    }
+    return mass_change - handed;
   }
 
   // Paired statuses (AdaptiveRefinementParameters::paired_statuses): level by level from the coarsest refined one,
@@ -669,6 +719,7 @@ class AdaptiveRefinement {
     leaving_.assign(n, 0);
     status_.assign(n, 0);
     removals_.clear();
+    activated_id_.clear();
     for (std::size_t a = 0; a < n; ++a) {
       if (p.kind[a] != Kind::fluid) continue;
       const int k = level_of_particle(p, a);
@@ -697,6 +748,7 @@ class AdaptiveRefinement {
       const std::uint8_t passive = status_[a];
       if (passive != p.passive[a]) {
         ++(passive ? counts.deactivated : counts.activated);
+        if (!passive && params_.activated_mass_bound > T(0)) activated_id_.push_back(p.id[a]);
         const double sign = passive ? -1.0 : 1.0;
         const auto level = static_cast<std::size_t>(std::clamp(k, 0, Box::max_level));
         counts.status_mass[level] += sign * static_cast<double>(p.mass[a]);
@@ -985,6 +1037,8 @@ class AdaptiveRefinement {
   ParticleShifting<System> shifter_;
   AdaptiveRefinementCounts last_{}, total_{};
   T pending_mass_{0};                        // the relaxed mass account's mass still to hand back
+  std::vector<std::uint32_t> activated_id_;  // ids of the particles a pass made active (activated_mass_bound > 0)
+  std::vector<std::size_t> activated_;       // their slots after the pass
   T last_pass_time_{0};                      // time of the last pass (the relaxed mass account's dt, distant fits)
   T box_displacement_{0};                    // how far the boxes moved along x (boxes_follow_flow), m
   std::vector<int> level_;                   // per slot of the pass: level

@@ -102,6 +102,9 @@ struct PlantRefinement {
   /// AdaptiveRefinementParameters::paired_exchange: with paired_statuses, a coarse particle and its paired fine ones
   /// exchange mass and momentum as they change status
   bool paired_exchange{false};
+  /// AdaptiveRefinementParameters::activated_mass_bound: the mass account hands a pass's change first to the particles
+  /// that became active in it, each within this fraction of its nominal mass, [0, 1); 0: off
+  T activated_mass_bound{0};
   /// AdaptiveRefinementParameters::account_over_all_fluid: the accounts hand their changes to all active fluid
   bool account_over_all_fluid{false};
   /// AdaptiveRefinementParameters::passive_mass_from_volume: passive masses from their SPH volume (else nominal)
@@ -242,6 +245,7 @@ struct PosidoniaFlume {
     a.edge_dither = refinement.edge_dither;
     a.paired_statuses = refinement.paired_statuses;
     a.paired_exchange = refinement.paired_exchange;
+    a.activated_mass_bound = refinement.activated_mass_bound;
     a.account_over_all_fluid = refinement.account_over_all_fluid;
     a.passive_mass_from_volume = refinement.passive_mass_from_volume;
     return a;
