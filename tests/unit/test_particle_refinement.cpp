@@ -1335,7 +1335,8 @@ TEST_CASE("adaptive refinement: the activated account hands a status change's ma
       activated += apr.last_counts().activated;
       for (std::size_t i = 0; i < p.size(); ++i) {
         if (p.kind[i] != Kind::fluid || p.passive[i]) continue;
-        const double nominal = 1000 * std::pow(dp * p.smoothing_length[i] / (1.3 * dp), 2);
+        const double spacing = dp / double(1 << apr.level_of(p.smoothing_length[i]));
+        const double nominal = 1000 * spacing * spacing;
         worst_nominal = std::max(worst_nominal, std::abs(p.mass[i] / nominal - 1));
         if (const auto it = active_before.find(p.id[i]); it != active_before.end())
           worst_stayed = std::max(worst_stayed, std::abs(p.mass[i] / it->second - 1));
