@@ -291,7 +291,8 @@ scenes::PosidoniaFlume<T> converted(const scenes::PosidoniaFlume<double>& s) {
                   s.refinement.paired_exchange,
                   T(s.refinement.activated_mass_bound),
                   s.refinement.account_over_all_fluid,
-                  s.refinement.passive_mass_from_volume};
+                  s.refinement.passive_mass_from_volume,
+                  T(s.refinement.passive_mass_bound)};
   return c;
 }
 
@@ -1099,7 +1100,12 @@ int main(int argc, char** argv) try {
   s.refinement.account_over_all_fluid = account_region == "all";
   s.refinement.passive_mass_from_volume =
       cli.get_switch("volume-mass", true,
-                     "refinement: passive masses from their SPH volume, capped at nominal (off: nominal): on | off");
+                     "refinement: passive masses from their SPH volume, capped at --passive-mass-bound (off: "
+                     "nominal): on | off");
+  s.refinement.passive_mass_bound = cli.get_number(
+      "passive-mass-bound", 1,
+      "refinement: the largest volume-based passive mass, in nominal masses, [1, 2] (above 1 the number density "
+      "counts the walls of the particle's resolution too)");
   o.local_steps = cli.get_switch("local-steps", false,
                                  "refinement: local time stepping, the coarse fluid at twice the fine step: on | off");
   o.fine_step_margin = cli.get_number(

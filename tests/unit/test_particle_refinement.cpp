@@ -10,11 +10,13 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <map>
 #include <random>
 #include <set>
+#include <tuple>
 
 using namespace sphfsi;
 namespace tank = sphfsi::examples::tank;
@@ -1376,6 +1378,89 @@ TEST_CASE("adaptive refinement: the activated account hands a status change's ma
 // drift along x rescales only the particles within transition_width of the vertical faces: the fine particles of the
 // bottom row in the middle of the box (more than 2.5 dp from them) keep their masses. With the bottom face open, the
 // dither moves it: some bottom-row particles take the other status, and the account band takes in the bottom row.
+// passive_mass_bound: a passive particle's mass is its SPH volume times rho0, at most the bound times its nominal mass.
+// (1) The block stretched by 5 % along both axes: every particle stands for 1.05^2 = 1.1025 of its cell. The coarse
+// passive particles two supports inside the box take that volume with a bound of 1.2 (to the cubic spline's
+// partition-of-unity error on the two lattices, 1 %), the nominal mass with the default bound 1, and 1.05 with a
+// bound of 1.05. (2) The box on a bed of wall particles of both spacings, up to the block's free top: the bottom row's
+// coarse passive particles keep their nominal mass (the walls of their spacing fill their support, to 2 %: the
+// lattice's kernel sum), the top row's, with half a support of water, take the bound.
+TEST_CASE("adaptive refinement: passive masses follow their volume up to passive_mass_bound, walls counted",
+          "[refinement][apr]") {
+  constexpr double dp = AprBlock::dp, nominal = 1000 * dp * dp;
+  const V2 centre(12 * dp, 8 * dp);
+  auto stretched_masses = [&](double bound) {
+    AprBlock block;
+    block.boxes = {{V2(4 * dp, 2 * dp), V2(20 * dp, 14 * dp), 1}};
+    block.params.passive_mass_bound = bound;
+    Apr apr(block.system.domain(), block.boxes, block.params);
+    apr.populate(block.system);
+    auto& p = block.system.particles();
+    for (std::size_t i = 0; i < p.size(); ++i) p.position[i] = centre + 1.05 * (p.position[i] - centre);
+    block.system.update_neighbors(0);
+    apr.advance(block.system, 0, 1e-4);
+    std::vector<double> ratios;
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (p.passive[i] && apr.level_of(p.smoothing_length[i]) == 0 &&
+          block.boxes[0].contains(p.position[i], -2 * 2 * 1.3 * dp))
+        ratios.push_back(p.mass[i] / nominal);
+    return ratios;
+  };
+  for (const auto& [bound, lowest, highest] :
+       {std::tuple{1.2, 1.1025 * 0.99, 1.1025 * 1.01}, std::tuple{1.0, 1.0, 1.0}, std::tuple{1.05, 1.05, 1.05}}) {
+    const auto ratios = stretched_masses(bound);
+    REQUIRE(ratios.size() >= 10);
+    const auto [min_ratio, max_ratio] = std::minmax_element(ratios.begin(), ratios.end());
+    INFO("bound " << bound << ": " << ratios.size() << " coarse passive particles, mass / nominal " << *min_ratio
+                  << " to " << *max_ratio);
+    CHECK(*min_ratio >= lowest * (1 - 1e-12));
+    CHECK(*max_ratio <= highest * (1 + 1e-12));
+  }
+  // (2) The box from the bed (three rows of coarse walls, four of fine ones) to the block's top.
+  AprBlock block;
+  auto& p = block.system.particles();
+  for (int i = -3; i < 27; ++i)
+    for (int j = 1; j <= 3; ++j)
+      p.add(Kind::wall, V2((i + 0.5) * dp, (0.5 - j) * dp), V2::Zero(), 1000, nominal, 1.3 * dp);
+  for (int i = -6; i < 54; ++i)
+    for (int j = 1; j <= 4; ++j)
+      p.add(Kind::wall, V2((i + 0.5) * dp / 2, (0.5 - j) * dp / 2), V2::Zero(), 1000, nominal / 4, 0.65 * dp);
+  block.system.update_pressure();
+  block.boxes = {{V2(6 * dp, 0), V2(18 * dp, 16 * dp), 1}};
+  block.params.passive_mass_bound = 1.2;
+  Apr apr(block.system.domain(), block.boxes, block.params);
+  apr.populate(block.system);
+  block.system.update_neighbors(0);
+  apr.advance(block.system, 0, 1e-4);
+  double bottom_lowest = 2, bottom_highest = 0, top_lowest = 2;
+  std::size_t bottom = 0, top = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (p.kind[i] != Kind::fluid || !p.passive[i] || apr.level_of(p.smoothing_length[i]) != 0) continue;
+    if (p.position[i][0] < 9 * dp || p.position[i][0] > 15 * dp) continue;
+    const double ratio = p.mass[i] / nominal;
+    if (p.position[i][1] < dp) {
+      ++bottom;
+      bottom_lowest = std::min(bottom_lowest, ratio);
+      bottom_highest = std::max(bottom_highest, ratio);
+    } else if (p.position[i][1] > 15 * dp) {
+      ++top;
+      top_lowest = std::min(top_lowest, ratio);
+    }
+  }
+  INFO("bottom row: " << bottom << " particles, mass / nominal " << bottom_lowest << " to " << bottom_highest
+                      << "; top row: " << top << ", at least " << top_lowest);
+  REQUIRE(bottom >= 5);
+  REQUIRE(top >= 5);
+  CHECK(bottom_lowest >= 0.98);
+  CHECK(bottom_highest <= 1.02);
+  CHECK(top_lowest == Approx(1.2).epsilon(1e-12));
+  // The bound lies in [1, 2].
+  auto params = block.params;
+  params.passive_mass_bound = 0.9;
+  CHECK_THROWS_WITH(Apr(block.system.domain(), block.boxes, params),
+                    Catch::Contains("passive_mass_bound") && Catch::Contains("valid range"));
+}
+
 TEST_CASE("adaptive refinement: wall faces of a box are not dithered and take no account band", "[refinement][apr]") {
   constexpr double dp = AprBlock::dp;
   for (const bool wall : {true, false}) {

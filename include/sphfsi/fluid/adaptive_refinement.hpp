@@ -26,7 +26,8 @@
 //   with linear_interpolation = false, the Shepard mean f_a = sum_b V_b f_b W_ab / sum_b V_b W_ab
 //   (interpolate_from_own_level = false: from the other levels only, the scheme of Chiron et al.; measured worse).
 //   and their mass is their SPH volume times their density, m_a = rho_a / sum_b W(r_ab, h_a) over the particles of
-//   their level, at most the nominal mass rho0 (dp / 2^k)^Dim: passive particles follow an interpolated velocity,
+//   their level, at most passive_mass_bound (default 1) times the nominal mass rho0 (dp / 2^k)^Dim (with a bound above
+//   1 the walls of their resolution count in the sum too): passive particles follow an interpolated velocity,
 //   not their own pressure, and may bunch up; so bunched, they do not weigh more in their active neighbours' sums
 //   than the fluid they stand for. A particle that becomes active keeps that mass.
 //   Children: an active particle of level k in the transition zone of a finer box (k < L_near) has the 2^Dim
@@ -146,9 +147,16 @@ struct AdaptiveRefinementParameters {
   /// stencil is one-sided (a free surface) the fit extrapolates and may overshoot; inside the neighbours' hull a linear
   /// field lies within their range, so the limit leaves the fit exact there.
   bool limit_fit{false};
-  /// Whether a passive particle's mass is its SPH volume times its density (capped at the nominal mass), else the
-  /// nominal mass rho0 s^Dim.
+  /// Whether a passive particle's mass is its SPH volume times its density (at most passive_mass_bound nominal
+  /// masses), else the nominal mass rho0 s^Dim.
   bool passive_mass_from_volume{true};
+  /// With passive_mass_from_volume: the largest passive mass, in nominal masses of its level, [1, 2]. At 1 (the
+  /// default) passive particles that spread apart keep the nominal mass, so they stand for less water than their
+  /// place holds; a status change then brings in less active mass than the other resolution gives up, which the mass
+  /// account has to hand back (the loop through the box's top face of docs/variable-resolution.md, session 34). Above 1
+  /// the mass follows the volume up to the bound, and the number density also counts the wall particles of the
+  /// particle's own resolution, so that a particle next to a wall does not see a one-sided support as spread water.
+  T passive_mass_bound{1};
   /// Hysteresis of the active / passive status at a box edge, in base spacings, [0, transition_width / base_spacing -
   /// smoothing_ratio] (a fine particle kept active outside its box keeps its support inside the transition zone):
   /// within this distance of an edge (on either side) a particle keeps its status, so one that oscillates across the
@@ -248,6 +256,8 @@ struct AdaptiveRefinementParameters {
     require_in_range("AdaptiveRefinementParameters::mass_account_relaxation (tau, s)", mass_account_relaxation, T(0),
                      T(1e6));
     require_in_range("AdaptiveRefinementParameters::distant_fit_interval (s)", distant_fit_interval, T(0), T(1));
+    require_in_range("AdaptiveRefinementParameters::passive_mass_bound (nominal masses)", passive_mass_bound, T(1),
+                     T(2));
     if (!(activated_mass_bound >= T(0) && activated_mass_bound < T(1)))
       throw InputError(
           fmt::format("AdaptiveRefinementParameters::activated_mass_bound = {} is invalid: valid range is "
@@ -958,11 +968,13 @@ class AdaptiveRefinement {
     for (std::size_t a = 0; a < n; ++a)
       if (p.kind[a] == Kind::fluid) level_[a] = level_of_particle(p, a);
     missing_.assign(n, 0);
-    // Passive masses: rho_a / sum_b W_ab over the particles of its level (its SPH volume), at most the nominal
-    // mass, so passive particles that bunched up (they follow an interpolated velocity, not their own pressure)
-    // do not weigh more in their active neighbours' sums than the fluid they stand for. The number density is
-    // summed in the fit's traversal.
+    // Passive masses: rho_a / sum_b W_ab over the particles of its level (its SPH volume), at most passive_mass_bound
+    // nominal masses, so passive particles that bunched up (they follow an interpolated velocity, not their own
+    // pressure) do not weigh more in their active neighbours' sums than the fluid they stand for. The number density
+    // is summed in the fit's traversal; above a bound of 1 it counts the walls of the particle's resolution as well.
     const bool from_volume = params_.passive_mass_from_volume;
+    const T mass_bound = params_.passive_mass_bound;
+    const bool count_walls = mass_bound > T(1);
     parallel_for(n, [&](std::size_t a) {
       if (p.kind[a] != Kind::fluid || !p.passive[a]) return;
       if (!fit_distant && distant(p.position[a], level_[a])) return;
@@ -975,7 +987,12 @@ class AdaptiveRefinement {
                    (level_[b] != level_[a] || params_.interpolate_from_own_level);
           },
           [&](std::size_t b, T r) {
-            if (from_volume && p.kind[b] == Kind::fluid && level_[b] == level_[a]) number_density += kernel.value(r, h);
+            if (!from_volume) return;
+            const bool own_resolution =
+                p.kind[b] == Kind::fluid
+                    ? level_[b] == level_[a]
+                    : count_walls && p.kind[b] == Kind::wall && std::abs(p.smoothing_length[b] - h) < T(0.25) * h;
+            if (own_resolution) number_density += kernel.value(r, h);
           });
       if (!found) missing_[a] = 1;
       if (!from_volume) {
@@ -983,7 +1000,7 @@ class AdaptiveRefinement {
         return;
       }
       p.mass[a] = nominal_mass(level_[a], rho0) *
-                  std::min(T(1), lattice_number_density_ / (number_density * cell_volume(spacing_of(level_[a]))));
+                  std::min(mass_bound, lattice_number_density_ / (number_density * cell_volume(spacing_of(level_[a]))));
     });
     for (std::uint8_t m : missing_) counts.uninterpolated += m;
   }

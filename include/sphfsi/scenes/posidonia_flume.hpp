@@ -109,6 +109,8 @@ struct PlantRefinement {
   bool account_over_all_fluid{false};
   /// AdaptiveRefinementParameters::passive_mass_from_volume: passive masses from their SPH volume (else nominal)
   bool passive_mass_from_volume{true};
+  /// AdaptiveRefinementParameters::passive_mass_bound: the largest passive mass in nominal masses, [1, 2]
+  T passive_mass_bound{1};
 };
 
 /// The Posidonia flume: waves, resolution, plants and blade model (lengths in m).
@@ -248,6 +250,7 @@ struct PosidoniaFlume {
     a.activated_mass_bound = refinement.activated_mass_bound;
     a.account_over_all_fluid = refinement.account_over_all_fluid;
     a.passive_mass_from_volume = refinement.passive_mass_from_volume;
+    a.passive_mass_bound = refinement.passive_mass_bound;
     return a;
   }
   /// The real blade as a line of rod nodes (rod, drag), not a continuum of particle rows (scaled, equivalent).
