@@ -587,8 +587,10 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
       }
     fmt::print(
         "refinement: {} fluid particles at the end ({} active, {} passive, {} fine); {} children created, {} removed; "
-        "largest mass-account correction {:.2e}, momentum-account velocity shift {:.2e} m/s\n",
-        active + passive, active, passive, fine, c.created, c.removed, c.mass_correction, c.momentum_correction);
+        "largest mass-account correction {:.2e}, momentum-account velocity shift {:.2e} m/s; largest passive mass "
+        "{:.4f} nominal masses\n",
+        active + passive, active, passive, fine, c.created, c.removed, c.mass_correction, c.momentum_correction,
+        c.passive_mass_highest);
     if (scene.refinement.paired_exchange)
       fmt::print("refinement: paired exchange in {} groups, {} groups left to the accounts\n", c.exchanged,
                  c.exchange_skipped);

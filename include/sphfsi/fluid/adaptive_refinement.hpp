@@ -310,6 +310,9 @@ struct AdaptiveRefinementCounts {
   /// the coarse one's).
   std::size_t exchanged{0};
   std::size_t exchange_skipped{0};
+  /// Largest mass of a passive fluid particle over its level's nominal mass, after the pass (with
+  /// passive_mass_from_volume at most passive_mass_bound; 0 without passive particles).
+  double passive_mass_highest{0};
 };
 
 /// Adaptive particle refinement with overlapping resolutions (see the header comment). A ParticleModel: it adds no
@@ -538,6 +541,7 @@ class AdaptiveRefinement {
     total_.mass_correction = std::max(total_.mass_correction, c.mass_correction);
     total_.momentum_correction = std::max(total_.momentum_correction, c.momentum_correction);
     total_.pending_mass = std::max(total_.pending_mass, c.pending_mass);
+    total_.passive_mass_highest = std::max(total_.passive_mass_highest, c.passive_mass_highest);
     for (std::size_t k = 0; k < c.status_mass.size(); ++k) {
       total_.status_mass[k] += c.status_mass[k];
       total_.status_nominal_mass[k] += c.status_nominal_mass[k];
@@ -1003,6 +1007,10 @@ class AdaptiveRefinement {
                   std::min(mass_bound, lattice_number_density_ / (number_density * cell_volume(spacing_of(level_[a]))));
     });
     for (std::uint8_t m : missing_) counts.uninterpolated += m;
+    for (std::size_t a = 0; a < n; ++a)
+      if (p.kind[a] == Kind::fluid && p.passive[a])
+        counts.passive_mass_highest =
+            std::max(counts.passive_mass_highest, static_cast<double>(p.mass[a] / nominal_mass(level_[a], rho0)));
   }
 
   // Whether a passive particle of level k at x lies farther than two kernel supports of its level (plus the status
