@@ -992,10 +992,10 @@ class AdaptiveRefinement {
           },
           [&](std::size_t b, T r) {
             if (!from_volume) return;
-            const bool own_resolution =
-                p.kind[b] == Kind::fluid
-                    ? level_[b] == level_[a]
-                    : count_walls && p.kind[b] == Kind::wall && std::abs(p.smoothing_length[b] - h) < T(0.25) * h;
+            const bool own_resolution = p.kind[b] == Kind::fluid
+                                            ? level_[b] == level_[a]
+                                            : count_walls && p.kind[b] == Kind::wall &&
+                                                  std::abs(p.smoothing_length[b] - h) < level_tolerance * h;
             if (own_resolution) number_density += kernel.value(r, h);
           });
       if (!found) missing_[a] = 1;
