@@ -1372,12 +1372,6 @@ TEST_CASE("adaptive refinement: the activated account hands a status change's ma
   CHECK_THROWS_WITH(bad.validate(), Catch::Contains("conserve_mass"));
 }
 
-// Wall faces (RefinementBox::wall_faces): a box standing on the bottom of the block (its lower face at y = 0, where no
-// fluid crosses). With the bottom face a wall face, the particles along it keep the statuses of the box itself under
-// a dither of one dp (every fine particle in the box active, every coarse one passive), and the mass account of a
-// drift along x rescales only the particles within transition_width of the vertical faces: the fine particles of the
-// bottom row in the middle of the box (more than 2.5 dp from them) keep their masses. With the bottom face open, the
-// dither moves it: some bottom-row particles take the other status, and the account band takes in the bottom row.
 // passive_mass_bound: a passive particle's mass is its SPH volume times rho0, at most the bound times its nominal mass.
 // (1) The block stretched by 5 % along both axes: every particle stands for 1.05^2 = 1.1025 of its cell. The coarse
 // passive particles two supports inside the box take that volume with a bound of 1.2 (to the cubic spline's
@@ -1463,6 +1457,12 @@ TEST_CASE("adaptive refinement: passive masses follow their volume up to passive
                     Catch::Contains("passive_mass_bound") && Catch::Contains("valid range"));
 }
 
+// Wall faces (RefinementBox::wall_faces): a box standing on the bottom of the block (its lower face at y = 0, where no
+// fluid crosses). With the bottom face a wall face, the particles along it keep the statuses of the box itself under
+// a dither of one dp (every fine particle in the box active, every coarse one passive), and the mass account of a
+// drift along x rescales only the particles within transition_width of the vertical faces: the fine particles of the
+// bottom row in the middle of the box (more than 2.5 dp from them) keep their masses. With the bottom face open, the
+// dither moves it: some bottom-row particles take the other status, and the account band takes in the bottom row.
 TEST_CASE("adaptive refinement: wall faces of a box are not dithered and take no account band", "[refinement][apr]") {
   constexpr double dp = AprBlock::dp;
   for (const bool wall : {true, false}) {
