@@ -979,6 +979,11 @@ int main(int argc, char** argv) try {
   Options o;
   auto& s = o.scene;
   s.wave_height = cli.get_number("height", 0.03, "target wave height H, m");
+  const auto gauges = cli.get_numbers("gauges", "0.6,1,1.3,1.7",
+                                      "wave gauge positions, m, comma-separated, before the damping zone (H per gauge; "
+                                      "the incident and reflected waves from those upstream of the first plant)");
+  if (gauges.empty()) throw InputError("--gauges: at least one gauge position is needed (m, in (0, 2) by default)");
+  s.gauges.assign(gauges.begin(), gauges.end());
   s.period = cli.get_number("period", 1.2, "wave period T, s");
   s.ramp_periods = cli.get_number("ramp", 2, "paddle start-up ramp, periods");
   s.particles_per_depth = cli.get_number("resolution", 20, "particles over the depth h/dp (40: dp = 5 mm)");

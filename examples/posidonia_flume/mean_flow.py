@@ -1,16 +1,21 @@
 """The slow part of a posidonia_flume run: the plant's mean position, the mean current beside it, and the long waves.
 
-Usage: /usr/bin/python3 examples/posidonia_flume/mean_flow.py REFERENCE_DIR RUN_DIR... [--csv FILE] [--plot PNG]
+Usage: /usr/bin/python3 examples/posidonia_flume/mean_flow.py REFERENCE_DIR RUN_DIR... [--until T] [--csv FILE]
+       [--plot PNG]
 
 For each run folder (written with --runs plants or both), from DIR/plants/gauges.csv and DIR/plants/tips.csv:
   * H at each gauge against the reference run's (DIR/plants/wave_heights.csv), %;
   * the tip's half peak-to-peak excursion in x (the example's criterion) and the half peak-to-peak of its periodic
     part: 4 harmonics of the wave fitted together with a quadratic drift (as analysis::fit_harmonics), mm;
+  * the tip's vertical half peak-to-peak excursion, mm;
   * the tip's mean displacement and the Eulerian mean current at the plant's mid-height, mm and mm/s;
   * the long waves: the mean level of each gauge over one wave period, every half period from 4.2 s on. "spread" is
     the mean over those windows of the largest difference between the gauges (a level gradient along the flume);
     "wander" the rms of each gauge's window means about their straight-line trend, averaged over the gauges, mm.
 All over the window the example uses for the tip (from the ramp, the wave's travel to the plant and one period).
+--until T ends every window at T s, so that the first part of a longer record can be compared with a shorter run:
+H is then found from DIR/plants/gauges.csv by zero up-crossings (as analysis::zero_crossing_analysis) from the
+example's start for each gauge (ramp, travel at the group velocity, one period) to T, in the reference as in the runs.
 --plot draws the tip's excursion and its periodic part against the reference's, over the level's wander and over the
 mean lean; runs whose folder name contains 'pf40' are drawn as uniformly fine, 'pf20' as uniformly coarse.
 """
@@ -45,18 +50,40 @@ def periodic_half_range(t, y, harmonics=4, degree=2):
     return 0.5 * (part.max() - part.min())
 
 
-def heights(run):
-    return read(run + '/plants/wave_heights.csv')['H']
+def zero_crossing_height(t, eta, start, end):
+    """Mean height of the complete zero up-crossing waves of eta over [start, end] (analysis/zero_crossing.hpp)."""
+    w = (t >= start) & (t <= end)
+    e = eta[w] - eta[w].mean()
+    up = np.nonzero((e[:-1] < 0) & (e[1:] >= 0))[0] + 1
+    return np.mean([e[a:b].max() - e[a:b].min() for a, b in zip(up[:-1], up[1:])])
 
 
-def analyse(run, reference_heights):
-    tips = read(run + '/plants/tips.csv')
-    window = tips['t'] >= TIP_FROM - 1e-9
-    t, dx, u = tips['t'][window], tips['dx_0'][window], tips['u_mid_0'][window]
+def heights(run, until=None):
+    """(gauge positions, H) of a run, m."""
+    if until is None:
+        h = read(run + '/plants/wave_heights.csv')
+        return np.atleast_1d(h['x']), np.atleast_1d(h['H'])
     gauges = read(run + '/plants/gauges.csv')
+    with open(run + '/plants/gauges.csv') as f:  # the column names eta_<x in m> (numpy drops their '.')
+        header = next(line for line in f if not line.startswith('#'))
+    xs = [float(n[4:]) for n in header.strip().split(',') if n.startswith('eta_')]
+    names = [n for n in gauges.dtype.names if n.startswith('eta')]
+    return np.array(xs), np.array([zero_crossing_height(gauges['t'], gauges[n], 2 * T + x / GROUP_VELOCITY + T,
+                                                        until) for n, x in zip(names, xs)])
+
+
+def analyse(run, reference_heights, until=None):
+    """reference_heights: (gauge positions, H) of the reference; the run's gauges at those positions are compared
+    (a run may have more gauges, --gauges of the example)."""
+    tips = read(run + '/plants/tips.csv')
+    end = np.inf if until is None else until + 1e-9
+    window = (tips['t'] >= TIP_FROM - 1e-9) & (tips['t'] <= end)
+    t, dx, dz, u = tips['t'][window], tips['dx_0'][window], tips['dz_0'][window], tips['u_mid_0'][window]
+    gauges = read(run + '/plants/gauges.csv')
+    last = gauges['t'][-1] if until is None else min(until, gauges['t'][-1])
     names = [n for n in gauges.dtype.names if n.startswith('eta')]
     means, start = [], LEVEL_FROM
-    while start + T <= gauges['t'][-1] + 1e-6:
+    while start + T <= last + 1e-6:
         w = (gauges['t'] >= start) & (gauges['t'] < start + T)
         means.append([np.nanmean(gauges[n][w]) for n in names])
         start += T / 2
@@ -64,8 +91,11 @@ def analyse(run, reference_heights):
     k = np.arange(len(means))
     wander = np.mean([np.std(means[:, j] - np.polyval(np.polyfit(k, means[:, j], 1), k))
                       for j in range(means.shape[1])])
-    h = heights(run)
-    return dict(H=100 * (h / reference_heights - 1), half_peak_to_peak=1e3 * 0.5 * (dx.max() - dx.min()),
+    xs, h = heights(run, until)
+    x_ref, h_ref = reference_heights
+    h = np.array([h[np.argmin(np.abs(xs - x))] if np.min(np.abs(xs - x)) < 1e-6 else np.nan for x in x_ref])
+    return dict(H=100 * (h / h_ref - 1), half_peak_to_peak=1e3 * 0.5 * (dx.max() - dx.min()),
+                dz=1e3 * 0.5 * (dz.max() - dz.min()),
                 periodic=1e3 * periodic_half_range(t, dx), lean=1e3 * dx.mean(), current=1e3 * u.mean(),
                 spread=np.mean(means.max(1) - means.min(1)), wander=wander)
 
@@ -115,30 +145,33 @@ def plot(path, rows):
 def main(argv):
     csv_path, argv = option(argv, '--csv')
     plot_path, argv = option(argv, '--plot')
+    until, argv = option(argv, '--until')
+    until = None if until is None else float(until)
     if len(argv) < 2:
         sys.exit(__doc__)
     reference = argv[0]
-    h_ref = heights(reference)
+    h_ref = heights(reference, until)
     rows = []
     print(f"{'run':30s} {'H vs reference, % (per gauge)':>36s} | {'hpp dx':>6s} {'periodic':>8s} {'lean':>6s} "
-          f"{'current':>7s} | {'spread':>6s} {'wander':>6s}")
+          f"{'current':>7s} {'dz':>5s} | {'spread':>6s} {'wander':>6s}")
     for run in argv:
-        r = analyse(run, h_ref)
+        r = analyse(run, h_ref, until)
         rows.append((run, r))
         print(f"{run:30s} " + ' '.join(f'{e:+8.2f}' for e in r['H']) +
-              f" | {r['half_peak_to_peak']:6.2f} {r['periodic']:8.2f} {r['lean']:+6.2f} {r['current']:+7.2f} | "
+              f" | {r['half_peak_to_peak']:6.2f} {r['periodic']:8.2f} {r['lean']:+6.2f} {r['current']:+7.2f} {r['dz']:5.2f} | "
               f"{r['spread']:6.2f} {r['wander']:6.2f}")
     if csv_path:
         with open(csv_path, 'w') as f:
-            f.write('# examples/posidonia_flume/mean_flow.py against ' + reference + ': H error per gauge (%), tip half '
-                    'peak-to-peak and periodic half range (mm), mean lean (mm), mean current at mid-height (mm/s), '
-                    'long-wave spread and wander (mm)\n')
-            f.write('run,' + ','.join(f'H_error_{i}' for i in range(len(h_ref))) +
-                    ',tip_half_peak_to_peak,tip_periodic,lean,current,level_spread,level_wander\n')
+            window = '' if until is None else f' (every window ends at t = {until} s)'
+            f.write('# examples/posidonia_flume/mean_flow.py against ' + reference + window + ': H error per gauge '
+                    '(%), tip half peak-to-peak and periodic half range (mm), mean lean (mm), mean current at '
+                    'mid-height (mm/s), long-wave spread and wander (mm), tip half peak-to-peak in z (mm)\n')
+            f.write('run,' + ','.join(f'H_error_{i}' for i in range(len(h_ref[0]))) +
+                    ',tip_half_peak_to_peak,tip_periodic,lean,current,level_spread,level_wander,tip_dz\n')
             for run, r in rows:
                 f.write(run + ',' + ','.join(f'{e:.3f}' for e in r['H']) +
                         f",{r['half_peak_to_peak']:.3f},{r['periodic']:.3f},{r['lean']:.3f},{r['current']:.3f},"
-                        f"{r['spread']:.3f},{r['wander']:.3f}\n")
+                        f"{r['spread']:.3f},{r['wander']:.3f},{r['dz']:.3f}\n")
     if plot_path:
         plot(plot_path, rows)
 

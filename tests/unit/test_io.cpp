@@ -345,6 +345,19 @@ TEST_CASE("read_csv reads the shipped validation data", "[io][csv]") {
   CHECK(z[0] == 1.10782);
 }
 
+TEST_CASE("CommandLine::get_numbers: a comma-separated list, the default, and a clear error otherwise", "[io]") {
+  std::vector<std::string> words{"prog", "--x", "0.6,1,1.25e-1", "--bad", "0.6,,1", "--word", "0.6,one", "--empty", ""};
+  std::vector<char*> argv;
+  for (auto& w : words) argv.push_back(w.data());
+  sphfsi::io::CommandLine cli(int(argv.size()), argv.data(), "test");
+  CHECK(cli.get_numbers("x", "", "a list") == std::vector<double>{0.6, 1.0, 0.125});
+  CHECK(cli.get_numbers("absent", "2,3", "absent: the default") == std::vector<double>{2.0, 3.0});
+  CHECK(cli.get_numbers("empty", "1", "an empty value").empty());
+  CHECK_THROWS_WITH(cli.get_numbers("bad", "", "a list"), Catch::Contains("--bad") && Catch::Contains("item ''"));
+  CHECK_THROWS_WITH(cli.get_numbers("word", "", "a list"),
+                    Catch::Contains("--word") && Catch::Contains("item 'one' is not a number"));
+}
+
 TEST_CASE("CommandLine::get_switch: on, off, the default, and a clear error otherwise", "[io]") {
   std::vector<std::string> words{"prog", "--a", "on", "--b", "off", "--c", "yes"};
   std::vector<char*> argv;

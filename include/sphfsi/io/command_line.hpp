@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -40,6 +41,26 @@ class CommandLine {
     const double v = std::strtod(s.c_str(), &end);
     if (end == s.c_str() || *end != '\0') throw InputError(fmt::format("--{} = '{}' is not a number", name, s));
     return v;
+  }
+
+  /// A comma-separated list of numbers ("0.6,1.0,1.3"); an item that is not a number is an InputError naming the
+  /// flag and the item. An empty value gives an empty list.
+  std::vector<double> get_numbers(std::string_view name, std::string_view default_value, std::string_view help) {
+    const std::string s = get(name, default_value, help);
+    std::vector<double> values;
+    std::size_t begin = 0;
+    while (begin <= s.size() && !s.empty()) {
+      const std::size_t comma = std::min(s.find(',', begin), s.size());
+      const std::string item = s.substr(begin, comma - begin);
+      char* end = nullptr;
+      const double v = std::strtod(item.c_str(), &end);
+      if (item.empty() || end == item.c_str() || *end != '\0')
+        throw InputError(
+            fmt::format("--{} = '{}': item '{}' is not a number (a comma-separated list of numbers)", name, s, item));
+      values.push_back(v);
+      begin = comma + 1;
+    }
+    return values;
   }
 
   /// An on | off flag: true for "on"; any other value than "on" or "off" is an InputError naming the flag.
