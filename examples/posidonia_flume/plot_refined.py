@@ -2,7 +2,7 @@
 coarse runs of examples/posidonia_flume: H at the gauges, the tip's dx(t) and dz(t).
 
 Usage: plot_refined.py PNG LABEL=FOLDER ...   (each FOLDER an --output of posidonia_flume with a plants run;
-reads FOLDER/plants/wave_heights.csv and FOLDER/plants/tips.csv)"""
+reads FOLDER/plants/wave_heights.csv and FOLDER/plants/tips.csv; H at the first run's gauges)"""
 import os
 import sys
 
@@ -21,7 +21,10 @@ fig, (ax_h, ax_x, ax_z) = plt.subplots(3, 1, figsize=(9, 10))
 reference = read(f"{runs[0][1]}/plants/wave_heights.csv")
 for label, folder in runs:
     h = read(f"{folder}/plants/wave_heights.csv")
-    ax_h.plot(h["x"], [100 * (a / b - 1) for a, b in zip(h["H"], reference["H"])], "o-", label=label)
+    # the gauges of the first run, matched by position (a run may have more, posidonia_flume --gauges)
+    by_x = {round(x, 6): H for x, H in zip(h["x"], h["H"])}
+    shared = [(x, by_x[round(x, 6)], H0) for x, H0 in zip(reference["x"], reference["H"]) if round(x, 6) in by_x]
+    ax_h.plot([x for x, _, _ in shared], [100 * (a / b - 1) for _, a, b in shared], "o-", label=label)
     tips = read(f"{folder}/plants/tips.csv")
     ax_x.plot(tips["t"], [1e3 * v for v in tips["dx_0"]], lw=1, label=label)
     ax_z.plot(tips["t"], [1e3 * v for v in tips["dz_0"]], lw=1, label=label)
