@@ -14,9 +14,13 @@ relative to the incident one (rad), and the fit's residual (mm rms). --local add
 amplitude of the paddle's frequency at that gauge alone over the same windows (incident and reflected together), as
 columns local_<x>_mm and as a third panel of the plot.
 """
+import os
 import sys
 
 import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from mean_flow import option  # noqa: E402  (the same command-line option reader)
 
 T = 1.2        # wave period, s (the example's default)
 DEPTH = 0.2    # m
@@ -80,13 +84,6 @@ def history(run, gauges, periods, local=()):
                      1e3 * residual, *amplitudes))
         start += 0.5 * T
     return np.array(rows)
-
-
-def option(argv, name):
-    if name not in argv:
-        return None, argv
-    i = argv.index(name)
-    return argv[i + 1], argv[:i] + argv[i + 2:]
 
 
 def main(argv):
