@@ -49,7 +49,6 @@
 #include <limits>
 #include <numbers>
 #include <optional>
-#include <sstream>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -539,11 +538,11 @@ int main(int argc, char** argv) try {
   require_non_negative("--end-time (s)", o.end_time);
   o.depth_lengths = cli.get_number("depth", o.depth_lengths, "channel depth in blade lengths (blockage 1 / depth)");
   o.average_from = cli.get_number("average-from", o.average_from, "start of the drag average, blade lengths");
-  const std::string list = cli.get("cauchy", "0,1,3,10,30,100,300,1000", "target Cauchy numbers (0: rigid blade)");
-  const std::string inclination_list =
-      cli.get("inclinations", "",
-              "force-law sweep instead of the Cauchy sweep: rigid blades inclined by these angles from the vertical, "
-              "degrees in [0, 85], leaning downstream, the first 0 (writes inclined.csv)");
+  const auto cauchy = cli.get_numbers("cauchy", "0,1,3,10,30,100,300,1000", "target Cauchy numbers (0: rigid blade)");
+  const auto inclinations = cli.get_numbers(
+      "inclinations", "",
+      "force-law sweep instead of the Cauchy sweep: rigid blades inclined by these angles from the vertical, "
+      "degrees in [0, 85], leaning downstream, the first 0 (writes inclined.csv)");
   o.mount_height = cli.get_number("mount-height", 0,
                                   "force-law sweep: the rigid blades' base above the bed, blade lengths (0: on the "
                                   "bed; > 0: a plate in open water, away from the bed)");
@@ -591,14 +590,8 @@ int main(int argc, char** argv) try {
   require_in_range("--mount-height (blade lengths)", o.mount_height, T(0), o.depth_lengths - T(1));
   if (o.three_d && o.coupling != "repulsive")
     throw InputError("--three-d: the strip is coupled by --coupling repulsive only (the drag blade is 2D)");
-  const auto parse_list = [](const std::string& text) {
-    std::vector<T> values;
-    std::stringstream ss(text);
-    for (std::string item; std::getline(ss, item, ',');) values.push_back(std::stod(item));
-    return values;
-  };
-  o.cauchy = parse_list(list);
-  o.inclinations = parse_list(inclination_list);
+  o.cauchy.assign(cauchy.begin(), cauchy.end());
+  o.inclinations.assign(inclinations.begin(), inclinations.end());
   std::filesystem::create_directories(o.output);
   if (!o.inclinations.empty()) return o.three_d ? run_force_law_sweep<3>(o) : run_force_law_sweep<2>(o);
   if (o.static_only) {  // the static blade under the model's law and under a measured one, no SPH run

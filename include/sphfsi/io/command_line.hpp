@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -37,10 +38,9 @@ class CommandLine {
 
   double get_number(std::string_view name, double default_value, std::string_view help) {
     const std::string s = get(name, fmt::format("{}", default_value), help);
-    char* end = nullptr;
-    const double v = std::strtod(s.c_str(), &end);
-    if (end == s.c_str() || *end != '\0') throw InputError(fmt::format("--{} = '{}' is not a number", name, s));
-    return v;
+    const auto v = number_from(s);
+    if (!v) throw InputError(fmt::format("--{} = '{}' is not a number", name, s));
+    return *v;
   }
 
   /// A comma-separated list of numbers ("0.6,1.0,1.3"); an item that is not a number is an InputError naming the
@@ -52,12 +52,11 @@ class CommandLine {
     while (begin <= s.size() && !s.empty()) {
       const std::size_t comma = std::min(s.find(',', begin), s.size());
       const std::string item = s.substr(begin, comma - begin);
-      char* end = nullptr;
-      const double v = std::strtod(item.c_str(), &end);
-      if (item.empty() || end == item.c_str() || *end != '\0')
+      const auto v = number_from(item);
+      if (!v)
         throw InputError(
             fmt::format("--{} = '{}': item '{}' is not a number (a comma-separated list of numbers)", name, s, item));
-      values.push_back(v);
+      values.push_back(*v);
       begin = comma + 1;
     }
     return values;
@@ -94,6 +93,14 @@ class CommandLine {
   }
 
  private:
+  /// The whole text as a number (strtod), or nothing if it is empty or has anything after the number.
+  static std::optional<double> number_from(const std::string& text) {
+    char* end = nullptr;
+    const double v = std::strtod(text.c_str(), &end);
+    if (end == text.c_str() || *end != '\0') return std::nullopt;
+    return v;
+  }
+
   struct Flag {
     std::string name, default_value, help;
   };
