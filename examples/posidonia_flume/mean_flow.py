@@ -50,6 +50,16 @@ def periodic_half_range(t, y, harmonics=4, degree=2):
     return 0.5 * (part.max() - part.min())
 
 
+def read_gauges(run):
+    """Times (s), elevations (m, one column per gauge) and gauge positions (m) of DIR/plants/gauges.csv."""
+    with open(run + '/plants/gauges.csv') as f:
+        lines = [line for line in f if not line.startswith('#')]
+    header = lines[0].strip().split(',')
+    data = np.array([[float(v) for v in line.split(',')] for line in lines[1:] if line.strip()])
+    xs = [float(n[4:]) for n in header if n.startswith('eta_')]
+    return data[:, 0], data[:, 1:], np.array(xs)
+
+
 def zero_crossing_height(t, eta, start, end):
     """Mean height of the complete zero up-crossing waves of eta over [start, end] (analysis/zero_crossing.hpp)."""
     w = (t >= start) & (t <= end)
@@ -63,13 +73,9 @@ def heights(run, until=None):
     if until is None:
         h = read(run + '/plants/wave_heights.csv')
         return np.atleast_1d(h['x']), np.atleast_1d(h['H'])
-    gauges = read(run + '/plants/gauges.csv')
-    with open(run + '/plants/gauges.csv') as f:  # the column names eta_<x in m> (numpy drops their '.')
-        header = next(line for line in f if not line.startswith('#'))
-    xs = [float(n[4:]) for n in header.strip().split(',') if n.startswith('eta_')]
-    names = [n for n in gauges.dtype.names if n.startswith('eta')]
-    return np.array(xs), np.array([zero_crossing_height(gauges['t'], gauges[n], 2 * T + x / GROUP_VELOCITY + T,
-                                                        until) for n, x in zip(names, xs)])
+    t, eta, xs = read_gauges(run)
+    return xs, np.array([zero_crossing_height(t, eta[:, j], 2 * T + x / GROUP_VELOCITY + T, until)
+                         for j, x in enumerate(xs)])
 
 
 def analyse(run, reference_heights, until=None):

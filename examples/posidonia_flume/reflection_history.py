@@ -20,7 +20,7 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from mean_flow import option  # noqa: E402  (the same command-line option reader)
+from mean_flow import option, read_gauges  # noqa: E402  (the same option and gauges.csv readers)
 
 T = 1.2        # wave period, s (the example's default)
 DEPTH = 0.2    # m
@@ -34,16 +34,6 @@ def wave_number(omega, depth):
         df = G * np.tanh(k * depth) + G * k * depth / np.cosh(k * depth) ** 2
         k -= f / df
     return k
-
-
-def read_gauges(run):
-    """Times (s), elevations (m, one column per gauge) and gauge positions (m) of DIR/plants/gauges.csv."""
-    with open(run + '/plants/gauges.csv') as f:
-        lines = [line for line in f if not line.startswith('#')]
-    header = lines[0].strip().split(',')
-    data = np.array([[float(v) for v in line.split(',')] for line in lines[1:] if line.strip()])
-    xs = [float(n[4:]) for n in header if n.startswith('eta_')]
-    return data[:, 0], data[:, 1:], np.array(xs)
 
 
 def gauge_columns(run, xs, gauges):
