@@ -4,13 +4,20 @@ active water, and how its mean mass flux differs from the uniformly fine run's.
 
     /usr/bin/python3 examples/posidonia_flume/flow_map.py REFERENCE RUN [RUN ...] --labels fine,paired,... \\
         --box 0.9,1.5,0.13 [--bin 0.01] [--plot map.png] [--csv regions.csv]
+    /usr/bin/python3 examples/posidonia_flume/flow_map.py REFERENCE RUN [RUN ...] --windows [--csv windows.csv]
 
 Prints, per run, the active mass the refinement's passes created in regions around the box (status changes and the
 accounts, kg per m width and second), the flux of mass through the box's faces, and the mean horizontal mass flux
 (a transport velocity) in the box's lower and upper halves against the reference. Maps: the mean horizontal mass flux
 of each run, its difference from the reference, and the sources of active mass, over x 0.7 to 1.7 m.
+
+With --windows (runs with --flow-map-window): per window of each run, the mean kinetic energy upstream of the box, in
+it and downstream of it (against the reference's in the same window), the mass per area and the volume fraction inside
+and outside the box, and over the pairs of bins that straddle its faces.
 """
 import argparse
+import glob
+import re
 import sys
 
 import numpy as np
@@ -64,6 +71,75 @@ def region_sum(xs, zs, field, bin_area, x0, x1, z0, z1):
     return field[np.ix_(mx, mz)].sum() * bin_area
 
 
+def window_files(run):
+    files = sorted(glob.glob(f'{run}/plants/flow_map_window*.csv'),
+                   key=lambda f: int(re.search(r'window(\d+)\.csv$', f).group(1)))
+    if not files:
+        sys.exit(f'flow_map.py: no {run}/plants/flow_map_window*.csv (run with --flow-map-window)')
+    return files
+
+
+def window_start(path):
+    with open(path) as f:
+        m = re.search(r'from t = ([0-9.eE+-]+) s', f.readline())
+    return float(m.group(1)) if m else float('nan')
+
+
+def window_table(runs, labels, box, csv_path):
+    """Per window: kinetic energy by region (against the reference), mass and volume inside and outside the box."""
+    bx0, bx1, btop = box
+    below = btop - 0.02  # the box's lower part, clear of its top face
+    regions = [('upstream', 0.5, bx0 - 0.05, 0, 1), ('box', bx0 + 0.05, bx1 - 0.05, 0, 1),
+               ('downstream', bx1 + 0.05, 1.9, 0, 1)]
+    columns = []
+    per_run = []
+    for run in runs:
+        rows = []
+        for path in window_files(run):
+            xs, zs, g = read_map(path)
+            area = (xs[1] - xs[0]) * (zs[1] - zs[0])
+            row = {'start': window_start(path)}
+            for name, x0, x1, z0, z1 in regions:
+                row[f'ke_{name}'] = region_sum(xs, zs, g['kinetic_energy'], area, x0, x1, z0, z1)
+
+            def mean(field, x0, x1, z0, z1):
+                return region_sum(xs, zs, g[field], area, x0, x1, z0, z1) / region_sum(
+                    xs, zs, np.ones_like(g[field]), area, x0, x1, z0, z1)
+
+            row['mass_box'] = mean('mass_per_area', bx0 + 0.05, bx1 - 0.05, 0, below)
+            row['mass_out'] = 0.5 * (mean('mass_per_area', 0.6, bx0 - 0.05, 0, below) +
+                                     mean('mass_per_area', bx1 + 0.05, 1.8, 0, below))
+            row['vf_box'] = mean('volume_fraction', bx0 + 0.05, bx1 - 0.05, 0, below)
+            row['vf_out'] = 0.5 * (mean('volume_fraction', 0.6, bx0 - 0.05, 0, below) +
+                                   mean('volume_fraction', bx1 + 0.05, 1.8, 0, below))
+            row['vf_faces'] = 0.5 * (mean('volume_fraction', bx0 - 0.01, bx0 + 0.01, 0, below) +
+                                     mean('volume_fraction', bx1 - 0.01, bx1 + 0.01, 0, below))
+            rows.append(row)
+        per_run.append(rows)
+        columns = list(rows[0].keys())
+    ref = per_run[0]
+    print('kinetic energy (time-mean, mJ per m width) upstream / in / downstream of the box, and against the reference; '
+          'mass per area (kg/m^3) and volume fraction below the box top - 2 cm, in the box / outside / over its faces:')
+    for rows, label in zip(per_run, labels):
+        print(f'  {label}:')
+        for k, row in enumerate(rows):
+            rel = [row[f'ke_{n}'] / ref[k][f'ke_{n}'] - 1 if k < len(ref) else float('nan') for n, *_ in regions]
+            ke = ' / '.join(f'{1e3 * row[f"ke_{n}"]:.3f}' for n, *_ in regions)
+            print(f'    from {row["start"]:6.2f} s: KE {ke} mJ/m (' + ' / '.join(f'{100 * v:+.2f}' for v in rel) + ' %); mass ' +
+                  f'{row["mass_box"]:.2f} / {row["mass_out"]:.2f}; volume fraction {row["vf_box"]:.4f} / '
+                  f'{row["vf_out"]:.4f} / {row["vf_faces"]:.4f}')
+    if csv_path:
+        with open(csv_path, 'w') as f:
+            f.write('# per window of the flow maps (flow_map.py --windows): time-mean kinetic energy upstream of the '
+                    'box, in it and downstream of it (J per m width), mass per area (kg/m^3) and volume fraction in the '
+                    'box and outside it below its top - 2 cm, and the volume fraction over the bins straddling its side '
+                    'faces\n')
+            f.write('run,' + ','.join(columns) + '\n')
+            for rows, label in zip(per_run, labels):
+                for row in rows:
+                    f.write(label + ',' + ','.join(f'{row[c]:.6g}' for c in columns) + '\n')
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument('runs', nargs='+', help='run folders (the first is the reference); their plants/flow_map.csv')
@@ -72,6 +148,8 @@ def main():
     ap.add_argument('--bin', type=float, default=0.01, help='bin of the maps and sums, m (a multiple of 2.5 mm)')
     ap.add_argument('--plot', default='', help='PNG of the maps')
     ap.add_argument('--csv', default='', help='CSV of the region sums')
+    ap.add_argument('--windows', action='store_true',
+                    help='compare the runs window by window (their flow_map_window*.csv, --flow-map-window)')
     ap.add_argument('--check-balance', type=float, default=0, metavar='TOL',
                     help='exit 1 unless, in every run, the status and account sources summed over the map cancel to '
                          'within TOL times the sum of the status sources\' magnitudes (a refined run with the mass '
@@ -81,6 +159,9 @@ def main():
     if len(labels) != len(a.runs):
         sys.exit('flow_map.py: --labels needs one label per run')
     bx0, bx1, btop = (float(v) for v in a.box.split(','))
+    if a.windows:
+        window_table(a.runs, labels, (bx0, bx1, btop), a.csv)
+        return
     if a.check_balance > 0:
         failed = False
         for r, label in zip(a.runs, labels):

@@ -62,7 +62,8 @@ struct Options {
   double waves_analysed{4};
   double end_time{0};
   double snapshots{0};
-  double flow_map_from{-1};  // --flow-map-from: time the period-mean flow map starts averaging, s (< 0: no map)
+  double flow_map_from{-1};   // --flow-map-from: time the period-mean flow map starts averaging, s (< 0: no map)
+  double flow_map_window{0};  // --flow-map-window: also a map per window of this length from flow_map_from, s (0: none)
   bool run_plants{true}, run_empty{true};
   bool check{false};  // exit 4 unless every plant sways with the water beside it and stands (see --check)
   // Rod blades: fluid pairs across a blade do not interact (fluid/thin_structure_visibility.hpp).
@@ -124,10 +125,10 @@ double eulerian_velocity(const System& system, const Vec<2, typename System::sca
 /// Time-mean map of the active fluid on a grid of square bins (flow_map.csv): per bin the mean number of active and
 /// passive particles of the coarse (level 0) and fine (level >= 1) resolution, the mean mass per area, the mean
 /// volume fraction sum m / rho / A, the mean mass flux sum m u / (rho0 A) (a transport velocity, m/s: divergence-free
-/// in a steady mean flow unless the bin holds a source of active mass), and the active mass the refinement's passes
-/// created there per unit time and area, split into status changes (a particle that became active with its mass, or
-/// passive) and the accounts (an active particle's mass rescaled), kg / (m^3 s). Diagnoses where a refined run makes
-/// or loses water (docs/variable-resolution.md, session 34).
+/// in a steady mean flow unless the bin holds a source of active mass), the mean kinetic energy per area, and the
+/// active mass the refinement's passes created there per unit time and area, split into status changes (a particle that
+/// became active with its mass, or passive) and the accounts (an active particle's mass rescaled), kg / (m^3 s).
+/// Diagnoses where a refined run makes or loses water (docs/variable-resolution.md, session 34).
 template <class System>
 class FlowMap {
  public:
@@ -185,20 +186,33 @@ class FlowMap {
       c[volume] += m / double(p.density[a]);
       c[flux_x] += m * double(p.velocity[a][0]);
       c[flux_z] += m * double(p.velocity[a][1]);
+      c[kinetic_energy] += 0.5 * m * double(p.velocity[a].squaredNorm());
       if (fine) c[fine_mass_ratio] += m / nominal_mass(level);
     }
     ++samples_;
   }
 
+  std::size_t samples() const { return samples_; }
+
+  /// Starts a new mean: the sums and the tracked time are cleared; each particle's last active mass is kept, so the
+  /// sources of the next window count from here.
+  void restart() {
+    std::fill(sums_.begin(), sums_.end(), 0.0);
+    samples_ = 0;
+    tracked_time_ = 0;
+  }
+
   void write(const std::filesystem::path& file, double from) const {
-    io::CsvWriter csv(file,
-                      {"x", "z", "active_coarse", "active_fine", "passive_coarse", "passive_fine", "mass_per_area",
-                       "volume_fraction", "flux_x", "flux_z", "fine_mass_ratio", "status_source", "account_source"},
-                      fmt::format("time-mean map of the active fluid from t = {} s ({} samples, {:.4f} s tracked); "
-                                  "bins of {} m, centres x, z (m); mean particle counts per bin; mass per area "
-                                  "kg/m^3; flux = sum m u / (rho0 A), m/s; fine_mass_ratio: mean mass / nominal of the "
-                                  "active fine particles; sources: active mass created per time and area, kg/(m^3 s)",
-                                  from, samples_, tracked_time_, bin_));
+    io::CsvWriter csv(
+        file,
+        {"x", "z", "active_coarse", "active_fine", "passive_coarse", "passive_fine", "mass_per_area", "volume_fraction",
+         "flux_x", "flux_z", "kinetic_energy", "fine_mass_ratio", "status_source", "account_source"},
+        fmt::format("time-mean map of the active fluid from t = {:.6g} s ({} samples, {:.4f} s tracked); "
+                    "bins of {} m, centres x, z (m); mean particle counts per bin; mass per area "
+                    "kg/m^3; flux = sum m u / (rho0 A), m/s; kinetic_energy = sum m u^2 / (2 A), J/m^3; "
+                    "fine_mass_ratio: mean mass / nominal of the "
+                    "active fine particles; sources: active mass created per time and area, kg/(m^3 s)",
+                    from, samples_, tracked_time_, bin_));
     const double area = bin_ * bin_, n = std::max<double>(double(samples_), 1.0);
     const double duration = tracked_time_ > 0 ? tracked_time_ : 1.0;
     for (std::size_t i = 0; i < nx_; ++i)
@@ -208,8 +222,8 @@ class FlowMap {
         csv.write_row({x0_ + (double(i) + 0.5) * bin_, (double(k) + 0.5) * bin_, c[active_coarse] / n,
                        c[active_fine] / n, c[passive_coarse] / n, c[passive_fine] / n, c[mass] / n / area,
                        c[volume] / n / area, c[flux_x] / n / area / rho0_, c[flux_z] / n / area / rho0_,
-                       fine_count > 0 ? c[fine_mass_ratio] / fine_count : 0.0, c[status_source] / duration / area,
-                       c[account_source] / duration / area});
+                       c[kinetic_energy] / n / area, fine_count > 0 ? c[fine_mass_ratio] / fine_count : 0.0,
+                       c[status_source] / duration / area, c[account_source] / duration / area});
       }
   }
 
@@ -223,6 +237,7 @@ class FlowMap {
     volume,
     flux_x,
     flux_z,
+    kinetic_energy,
     fine_mass_ratio,
     status_source,
     account_source,
@@ -442,11 +457,20 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
                              "above the bed (m, second number)");
   // the period-mean map of the active fluid (--flow-map-from): over the current probes' span along x, up to above the
   // crests, in bins of half the fine spacing of the refined runs (2.5 mm)
-  std::optional<FlowMap<System>> flow_map;
+  std::optional<FlowMap<System>> flow_map, window_map;
   if (o.flow_map_from >= 0)
     flow_map.emplace(current_x.front(), current_x.back(), 1.3 * double(scene.depth), 0.0025,
                      double(system.eos().reference_density()), double(g.smoothing_ratio * scene.dp()),
                      double(scene.dp()));
+  // --flow-map-window: the same map over consecutive windows, to see whether the mean flow changes along the record
+  if (flow_map && o.flow_map_window > 0) window_map.emplace(*flow_map);
+  std::size_t window_index = 0;
+  const auto window_start = [&](std::size_t k) { return o.flow_map_from + double(k) * o.flow_map_window; };
+  const auto write_window = [&]() {
+    window_map->write(dir / fmt::format("flow_map_window{}.csv", window_index), window_start(window_index));
+    window_map->restart();
+    ++window_index;
+  };
   // the active fluid's volume sum m / rho and mass, per unit width: a refinement box's status changes move water
   // between the active and the passive fluid, and its mass account hands the difference back at fixed density
   io::CsvWriter volume_csv(
@@ -494,6 +518,10 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
       progress(sm);
       r.particle_steps = sm.particle_steps();
       if (flow_map) flow_map->track(sm.system(), double(sm.time()), o.flow_map_from);
+      if (window_map) {
+        if (double(sm.time()) >= window_start(window_index + 1)) write_window();
+        window_map->track(sm.system(), double(sm.time()), o.flow_map_from);
+      }
       if constexpr (Rods && !Drag) {
         // Every step (porous blades: the water passes): between samples a particle beside the tip could go round it.
         crossings.update(sm.system(), sm.template model<1>());
@@ -502,6 +530,7 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
         gauges.sample(sm.system(), sm.time());
         record_volume(sm.system(), double(sm.time()));
         if (flow_map && double(sm.time()) >= o.flow_map_from) flow_map->sample(sm.system());
+        if (window_map && double(sm.time()) >= o.flow_map_from) window_map->sample(sm.system());
         {
           std::vector<double> row{double(sm.time())};
           for (double x : current_x)
@@ -560,6 +589,7 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
   }
   progress.finish(sim);
   if (flow_map) flow_map->write(dir / "flow_map.csv", o.flow_map_from);
+  if (window_map && window_map->samples() > 0) write_window();  // the last, possibly shorter, window
   r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   r.steps = sim.step_count();
   r.reached = double(sim.time());
@@ -1039,6 +1069,9 @@ int main(int argc, char** argv) try {
       "write flow_map.csv: the time-mean active fluid (counts per resolution, mass, volume, mass flux, the "
       "refinement's sources of active mass) in 2.5 mm bins over x 0.5 to 1.9 m, averaged from this time, s (< 0: "
       "no map)");
+  o.flow_map_window = cli.get_number("flow-map-window", 0,
+                                     "with --flow-map-from: also flow_map_window<k>.csv, the same map over consecutive "
+                                     "windows of this length, s (0: none)");
   std::string precision =
       cli.get("precision", "auto", "scalar type: float | double | auto (double for the rod, float otherwise)");
   o.out = cli.get("output", "out/posidonia_flume", "output folder");
@@ -1149,6 +1182,9 @@ int main(int argc, char** argv) try {
   if (o.fine_step_margin >= 0 && !o.local_steps)
     throw InputError(
         fmt::format("--fine-step-margin {}: only with --local-steps on (valid: < 0 without it)", o.fine_step_margin));
+  if (!(o.flow_map_window >= 0) || (o.flow_map_window > 0 && o.flow_map_from < 0))
+    throw InputError(fmt::format("--flow-map-window {}: valid is 0 (none) or a length > 0 s with --flow-map-from >= 0",
+                                 o.flow_map_window));
   s.validate();
   if (precision == "float") return run<float>(o);
   if (precision == "double") return run<double>(o);
