@@ -125,9 +125,10 @@ def window_table(runs, labels, box, csv_path):
         for k, row in enumerate(rows):
             rel = [row[f'ke_{n}'] / ref[k][f'ke_{n}'] - 1 if k < len(ref) else float('nan') for n, *_ in regions]
             ke = ' / '.join(f'{1e3 * row[f"ke_{n}"]:.3f}' for n, *_ in regions)
-            print(f'    from {row["start"]:6.2f} s: KE {ke} mJ/m (' + ' / '.join(f'{100 * v:+.2f}' for v in rel) + ' %); mass ' +
-                  f'{row["mass_box"]:.2f} / {row["mass_out"]:.2f}; volume fraction {row["vf_box"]:.4f} / '
-                  f'{row["vf_out"]:.4f} / {row["vf_faces"]:.4f}')
+            against = ' / '.join(f'{100 * v:+.2f}' for v in rel)
+            print(f'    from {row["start"]:6.2f} s: KE {ke} mJ/m ({against} %); mass {row["mass_box"]:.2f} / '
+                  f'{row["mass_out"]:.2f}; volume fraction {row["vf_box"]:.4f} / {row["vf_out"]:.4f} / '
+                  f'{row["vf_faces"]:.4f}')
     if csv_path:
         with open(csv_path, 'w') as f:
             f.write('# per window of the flow maps (flow_map.py --windows): time-mean kinetic energy upstream of the '
