@@ -72,11 +72,13 @@ def region_sum(xs, zs, field, bin_area, x0, x1, z0, z1):
 
 
 def window_files(run):
-    files = sorted(glob.glob(f'{run}/plants/flow_map_window*.csv'),
-                   key=lambda f: int(re.search(r'window(\d+)\.csv$', f).group(1)))
-    if not files:
-        sys.exit(f'flow_map.py: no {run}/plants/flow_map_window*.csv (run with --flow-map-window)')
-    return files
+    """The window maps of a run, in order: its plants run's, or its empty flume's if it has no plants run."""
+    for case in ('plants', 'empty'):
+        files = sorted(glob.glob(f'{run}/{case}/flow_map_window*.csv'),
+                       key=lambda f: int(re.search(r'window(\d+)\.csv$', f).group(1)))
+        if files:
+            return files
+    sys.exit(f'flow_map.py: no {run}/plants/ or {run}/empty/flow_map_window*.csv (run with --flow-map-window)')
 
 
 def window_start(path):
@@ -85,14 +87,16 @@ def window_start(path):
     return float(m.group(1)) if m else float('nan')
 
 
-def window_table(runs, labels, box, csv_path):
-    """Per window: kinetic energy by region (against the reference), mass and volume inside and outside the box."""
+def window_table(runs, labels, box, plant, csv_path, plot_path):
+    """Per window: kinetic energy by region (against the reference), mass and volume inside and outside the box, and
+    the mean vertical transport over the plant."""
     bx0, bx1, btop = box
     below = btop - 0.02  # the box's lower part, clear of its top face
     regions = [('upstream', 0.5, bx0 - 0.05, 0, 1), ('box', bx0 + 0.05, bx1 - 0.05, 0, 1),
                ('downstream', bx1 + 0.05, 1.9, 0, 1)]
     columns = []
     per_run = []
+    last_maps = []
     for run in runs:
         rows = []
         for path in window_files(run):
@@ -114,8 +118,18 @@ def window_table(runs, labels, box, csv_path):
                                    mean('volume_fraction', bx1 + 0.05, 1.8, 0, below))
             row['vf_faces'] = 0.5 * (mean('volume_fraction', bx0 - 0.01, bx0 + 0.01, 0, below) +
                                      mean('volume_fraction', bx1 - 0.01, bx1 + 0.01, 0, below))
+            # the mean upwelling over the plant: flux_z over plant +- 5 cm, 5 to 15 cm above the bed
+            row['upwelling'] = mean('flux_z', plant - 0.05, plant + 0.05, 0.05, 0.15)
+            # the strength of the mean circulation cells along the flume: the rms over 1 cm columns from 0.6 to 1.8 m of
+            # the vertical mass flux averaged over 2 to 17 cm above the bed (the sampling noise of single particles
+            # averages out over the column)
+            cx, cz, cg = coarsen(xs, zs, g, max(1, int(round(0.01 / (xs[1] - xs[0])))))
+            column = cg['flux_z'][:, (cz > 0.02) & (cz < 0.17)].mean(axis=1)
+            row['circulation'] = np.sqrt(np.mean(column[(cx > 0.6) & (cx < 1.8)] ** 2))
             rows.append(row)
+            last = (xs, zs, g)
         per_run.append(rows)
+        last_maps.append(last)
         columns = list(rows[0].keys())
     ref = per_run[0]
     print('kinetic energy (time-mean, mJ per m width) upstream / in / downstream of the box, and against the reference; '
@@ -128,17 +142,55 @@ def window_table(runs, labels, box, csv_path):
             against = ' / '.join(f'{100 * v:+.2f}' for v in rel)
             print(f'    from {row["start"]:6.2f} s: KE {ke} mJ/m ({against} %); mass {row["mass_box"]:.2f} / '
                   f'{row["mass_out"]:.2f}; volume fraction {row["vf_box"]:.4f} / {row["vf_out"]:.4f} / '
-                  f'{row["vf_faces"]:.4f}')
+                  f'{row["vf_faces"]:.4f}; upwelling over the plant {1e3 * row["upwelling"]:+.1f} mm/s; circulation '
+                  f'{1e3 * row["circulation"]:.1f} mm/s')
     if csv_path:
         with open(csv_path, 'w') as f:
             f.write('# per window of the flow maps (flow_map.py --windows): time-mean kinetic energy upstream of the '
                     'box, in it and downstream of it (J per m width), mass per area (kg/m^3) and volume fraction in the '
                     'box and outside it below its top - 2 cm, and the volume fraction over the bins straddling its side '
-                    'faces\n')
+                    'faces; the mean vertical mass flux over the plant +- 5 cm, 5 to 15 cm above the bed (m/s); the circulation: '
+                    'the rms along x (0.6-1.8 m, 1 cm columns) of the vertical mass flux averaged over 2-17 cm above '
+                    'the bed (m/s)\n')
             f.write('run,' + ','.join(columns) + '\n')
             for rows, label in zip(per_run, labels):
                 for row in rows:
                     f.write(label + ',' + ','.join(f'{row[c]:.6g}' for c in columns) + '\n')
+    if plot_path:
+        import matplotlib
+        matplotlib.use('Agg')
+        import matplotlib.pyplot as plt
+        n = len(runs)
+        fig = plt.figure(figsize=(15, 2.4 * n + 2.6))
+        grid = fig.add_gridspec(n + 1, 2)
+        for i, ((xs, zs, g), label, rows) in enumerate(zip(last_maps, labels, per_run)):
+            xs, zs, g = coarsen(xs, zs, g, 4)
+            mx, mz = (xs > 0.7) & (xs < 1.75), zs < 0.22
+            ext = [xs[mx][0] - 0.005, xs[mx][-1] + 0.005, 0, zs[mz][-1] + 0.005]
+            for col, name in enumerate(('flux_x', 'flux_z')):
+                ax = fig.add_subplot(grid[i, col])
+                im = ax.imshow(1e3 * g[name][np.ix_(mx, mz)].T, origin='lower', extent=ext, aspect='auto',
+                               cmap='RdBu_r', vmin=-60, vmax=60)
+                ax.add_patch(plt.Rectangle((bx0, 0), bx1 - bx0, btop, fill=False, ls='--', lw=0.8))
+                ax.axvline(plant, color='k', lw=0.6, ls=':')
+                ax.set_title(f'{label}: mean {"u" if col == 0 else "w"} (mass flux), mm/s, from {rows[-1]["start"]:.2f} s',
+                             fontsize=9)
+                ax.set_ylabel('z (m)')
+                fig.colorbar(im, ax=ax, fraction=0.03)
+        for col, (name, title) in enumerate((('upwelling', 'mean upwelling over the plant (mm/s)'),
+                                             ('circulation', 'circulation: rms of the column-mean w (mm/s)'))):
+            ax = fig.add_subplot(grid[n, col])
+            for rows, label in zip(per_run, labels):
+                ax.plot([r['start'] for r in rows], [1e3 * r[name] for r in rows], 'o-', label=label)
+            ax.set_xlabel('window start (s)')
+            ax.set_ylabel(title, fontsize=9)
+            if name == 'circulation':
+                ax.set_yscale('log')
+            ax.legend(fontsize=7)
+            ax.grid(alpha=0.3)
+        fig.tight_layout()
+        fig.savefig(plot_path, dpi=110)
+        print(f'plot: {plot_path}')
 
 
 def main():
@@ -151,6 +203,7 @@ def main():
     ap.add_argument('--csv', default='', help='CSV of the region sums')
     ap.add_argument('--windows', action='store_true',
                     help='compare the runs window by window (their flow_map_window*.csv, --flow-map-window)')
+    ap.add_argument('--plant', type=float, default=1.2, help='x of the plant (m), for --windows')
     ap.add_argument('--check-balance', type=float, default=0, metavar='TOL',
                     help='exit 1 unless, in every run, the status and account sources summed over the map cancel to '
                          'within TOL times the sum of the status sources\' magnitudes (a refined run with the mass '
@@ -161,7 +214,7 @@ def main():
         sys.exit('flow_map.py: --labels needs one label per run')
     bx0, bx1, btop = (float(v) for v in a.box.split(','))
     if a.windows:
-        window_table(a.runs, labels, (bx0, bx1, btop), a.csv)
+        window_table(a.runs, labels, (bx0, bx1, btop), a.plant, a.csv, a.plot)
         return
     if a.check_balance > 0:
         failed = False
