@@ -4,7 +4,8 @@ active water, and how its mean mass flux differs from the uniformly fine run's.
 
     /usr/bin/python3 examples/posidonia_flume/flow_map.py REFERENCE RUN [RUN ...] --labels fine,paired,... \\
         --box 0.9,1.5,0.13 [--bin 0.01] [--plot map.png] [--csv regions.csv]
-    /usr/bin/python3 examples/posidonia_flume/flow_map.py REFERENCE RUN [RUN ...] --windows [--csv windows.csv]
+    /usr/bin/python3 examples/posidonia_flume/flow_map.py REFERENCE RUN [RUN ...] --windows [--plant 1.2] \\
+        [--plot windows.png] [--csv windows.csv]
 
 Prints, per run, the active mass the refinement's passes created in regions around the box (status changes and the
 accounts, kg per m width and second), the flux of mass through the box's faces, and the mean horizontal mass flux
@@ -13,7 +14,9 @@ of each run, its difference from the reference, and the sources of active mass, 
 
 With --windows (runs with --flow-map-window): per window of each run, the mean kinetic energy upstream of the box, in
 it and downstream of it (against the reference's in the same window), the mass per area and the volume fraction inside
-and outside the box, and over the pairs of bins that straddle its faces.
+and outside the box, and over the pairs of bins that straddle its faces, the mean upwelling over the plant, and the
+strength of the mean circulation cells (the rms along the flume of the column-mean vertical flux); --plot draws the
+last window's mean flow of each run and the two histories.
 """
 import argparse
 import glob
@@ -132,8 +135,8 @@ def window_table(runs, labels, box, plant, csv_path, plot_path):
         last_maps.append(last)
         columns = list(rows[0].keys())
     ref = per_run[0]
-    print('kinetic energy (time-mean, mJ per m width) upstream / in / downstream of the box, and against the reference; '
-          'mass per area (kg/m^3) and volume fraction below the box top - 2 cm, in the box / outside / over its faces:')
+    print('kinetic energy (time-mean, mJ per m width) upstream / in / downstream of the box, and against the '
+          'reference; mass per area (kg/m^3) and volume fraction below the box top - 2 cm, in the box / outside / over its faces:')
     for rows, label in zip(per_run, labels):
         print(f'  {label}:')
         for k, row in enumerate(rows):
@@ -146,12 +149,12 @@ def window_table(runs, labels, box, plant, csv_path, plot_path):
                   f'{1e3 * row["circulation"]:.1f} mm/s')
     if csv_path:
         with open(csv_path, 'w') as f:
-            f.write('# per window of the flow maps (flow_map.py --windows): time-mean kinetic energy upstream of the '
-                    'box, in it and downstream of it (J per m width), mass per area (kg/m^3) and volume fraction in the '
-                    'box and outside it below its top - 2 cm, and the volume fraction over the bins straddling its side '
-                    'faces; the mean vertical mass flux over the plant +- 5 cm, 5 to 15 cm above the bed (m/s); the circulation: '
-                    'the rms along x (0.6-1.8 m, 1 cm columns) of the vertical mass flux averaged over 2-17 cm above '
-                    'the bed (m/s)\n')
+            f.write('# per window of the flow maps (flow_map.py --windows): time-mean kinetic energy upstream of '
+                    'the box, in it and downstream of it (J per m width), mass per area (kg/m^3) and volume fraction in '
+                    'the box and outside it below its top - 2 cm, and the volume fraction over the bins straddling its '
+                    'side faces; the mean vertical mass flux over the plant +- 5 cm, 5 to 15 cm above the bed (m/s); the '
+                    'circulation: the rms along x (0.6-1.8 m, 1 cm columns) of the vertical mass flux averaged over '
+                    '2-17 cm above the bed (m/s)\n')
             f.write('run,' + ','.join(columns) + '\n')
             for rows, label in zip(per_run, labels):
                 for row in rows:
@@ -173,8 +176,8 @@ def window_table(runs, labels, box, plant, csv_path, plot_path):
                                cmap='RdBu_r', vmin=-60, vmax=60)
                 ax.add_patch(plt.Rectangle((bx0, 0), bx1 - bx0, btop, fill=False, ls='--', lw=0.8))
                 ax.axvline(plant, color='k', lw=0.6, ls=':')
-                ax.set_title(f'{label}: mean {"u" if col == 0 else "w"} (mass flux), mm/s, from {rows[-1]["start"]:.2f} s',
-                             fontsize=9)
+                component = 'u' if col == 0 else 'w'
+                ax.set_title(f'{label}: mean {component} (mass flux), mm/s, from {rows[-1]["start"]:.2f} s', fontsize=9)
                 ax.set_ylabel('z (m)')
                 fig.colorbar(im, ax=ax, fraction=0.03)
         for col, (name, title) in enumerate((('upwelling', 'mean upwelling over the plant (mm/s)'),
