@@ -84,10 +84,55 @@ def window_files(run):
     sys.exit(f'flow_map.py: no {run}/plants/ or {run}/empty/flow_map_window*.csv (run with --flow-map-window)')
 
 
-def window_start(path):
+def map_header(path):
+    """(start time s, samples, tracked time s) from a flow map's first line."""
     with open(path) as f:
-        m = re.search(r'from t = ([0-9.eE+-]+) s', f.readline())
-    return float(m.group(1)) if m else float('nan')
+        line = f.readline()
+    start = re.search(r'from t = ([0-9.eE+-]+) s', line)
+    counts = re.search(r'\((\d+) samples, ([0-9.eE+-]+) s tracked\)', line)
+    return (float(start.group(1)) if start else float('nan'), int(counts.group(1)) if counts else 0,
+            float(counts.group(2)) if counts else float('nan'))
+
+
+def window_start(path):
+    return map_header(path)[0]
+
+
+def check_windows(runs, labels, tolerance):
+    """Exit 1 unless, in every run, the window maps add up to the whole-record map: the sampled fields weighted by
+    their windows' samples, the sources by their windows' tracked time, each to within `tolerance` of the field's
+    largest magnitude over the map."""
+    sampled = ['active_coarse', 'active_fine', 'passive_coarse', 'passive_fine', 'mass_per_area', 'volume_fraction',
+               'flux_x', 'flux_z', 'kinetic_energy']
+    tracked = ['status_source', 'account_source']
+    failed = False
+    for run, label in zip(runs, labels):
+        files = window_files(run)
+        whole_path = files[0].rsplit('/', 1)[0] + '/flow_map.csv'
+        _, whole_samples, whole_time = map_header(whole_path)
+        _, _, whole = read_map(whole_path)
+        sums = {name: np.zeros_like(whole[name]) for name in sampled + tracked}
+        samples, duration = 0, 0.0
+        for path in files:
+            _, n, t = map_header(path)
+            _, _, g = read_map(path)
+            for name in sampled:
+                sums[name] += n * g[name]
+            for name in tracked:
+                sums[name] += t * g[name]
+            samples, duration = samples + n, duration + t
+        worst = 0.0
+        for name in sampled + tracked:
+            weight = whole_samples if name in sampled else whole_time
+            scale = np.abs(whole[name]).max()
+            if scale > 0:
+                worst = max(worst, np.abs(sums[name] - weight * whole[name]).max() / (weight * scale))
+        ok = samples == whole_samples and abs(duration - whole_time) <= tolerance * whole_time and worst <= tolerance
+        failed = failed or not ok
+        print(f'{label}: {len(files)} windows, {samples} samples ({whole_samples} in the whole map), {duration:.9g} s '
+              f'tracked ({whole_time:.9g}); largest difference of the summed windows from the whole map {worst:.2e} of '
+              f'the field\'s largest magnitude (tolerance {tolerance:g}) ' + ('PASS' if ok else 'FAIL'))
+    sys.exit(1 if failed else 0)
 
 
 def window_table(runs, labels, box, plant, csv_path, plot_path):
@@ -207,6 +252,9 @@ def main():
     ap.add_argument('--windows', action='store_true',
                     help='compare the runs window by window (their flow_map_window*.csv, --flow-map-window)')
     ap.add_argument('--plant', type=float, default=1.2, help='x of the plant (m), for --windows')
+    ap.add_argument('--check-windows', type=float, default=0, metavar='TOL',
+                    help='exit 1 unless, in every run, the window maps add up to the whole-record map (sampled fields '
+                         'weighted by samples, sources by tracked time) within TOL of each field\'s largest magnitude')
     ap.add_argument('--check-balance', type=float, default=0, metavar='TOL',
                     help='exit 1 unless, in every run, the status and account sources summed over the map cancel to '
                          'within TOL times the sum of the status sources\' magnitudes (a refined run with the mass '
@@ -216,6 +264,8 @@ def main():
     if len(labels) != len(a.runs):
         sys.exit('flow_map.py: --labels needs one label per run')
     bx0, bx1, btop = (float(v) for v in a.box.split(','))
+    if a.check_windows > 0:
+        check_windows(a.runs, labels, a.check_windows)
     if a.windows:
         window_table(a.runs, labels, (bx0, bx1, btop), a.plant, a.csv, a.plot)
         return

@@ -207,7 +207,7 @@ class FlowMap {
         file,
         {"x", "z", "active_coarse", "active_fine", "passive_coarse", "passive_fine", "mass_per_area", "volume_fraction",
          "flux_x", "flux_z", "kinetic_energy", "fine_mass_ratio", "status_source", "account_source"},
-        fmt::format("time-mean map of the active fluid from t = {:.6g} s ({} samples, {:.4f} s tracked); "
+        fmt::format("time-mean map of the active fluid from t = {:.6g} s ({} samples, {:.9g} s tracked); "
                     "bins of {} m, centres x, z (m); mean particle counts per bin; mass per area "
                     "kg/m^3; flux = sum m u / (rho0 A), m/s; kinetic_energy = sum m u^2 / (2 A), J/m^3; "
                     "fine_mass_ratio: mean mass / nominal of the "

@@ -18,12 +18,16 @@ endif()
 # the map averaged from 1.2 s; the check reads it back and asks that the active mass the status changes made and the
 # mass account handed back cancel over the map to within 1e-6 of the status changes' summed magnitude (measured
 # 2.5e-10 in float; with --mass-account off the net is 1.2e-5 of it, so the check fails). About 30 s on one thread.
+# The same run writes the map over windows of 0.5 s (--flow-map-window, session 38); the second check asks that the
+# windows add up to the whole-record map (fields weighted by samples, sources by tracked time) within 1e-6 of each
+# field's largest magnitude: the CSV's 9 significant digits allow about 1e-8 (measured 7.4e-9); a window lost or
+# counted twice gives a difference of order 1.
 if(TARGET posidonia_flume)
   set(SPHFSI_FLOW_MAP_DIR ${CMAKE_CURRENT_BINARY_DIR}/posidonia_flow_map)
   add_test(NAME posidonia.flow_map_run
            COMMAND posidonia_flume --resolution 10 --refine on --paired-statuses on --refine-margin 0.15
-                   --refine-top 0.16 --end-time 2.5 --flow-map-from 1.2 --runs plants --snapshots 0
-                   --output ${SPHFSI_FLOW_MAP_DIR})
+                   --refine-top 0.16 --end-time 2.5 --flow-map-from 1.2 --flow-map-window 0.5 --runs plants
+                   --snapshots 0 --output ${SPHFSI_FLOW_MAP_DIR})
   set_tests_properties(posidonia.flow_map_run PROPERTIES LABELS "regression" TIMEOUT 300 FIXTURES_SETUP
                        sphfsi_flow_map ENVIRONMENT "OMP_NUM_THREADS=1;OMP_WAIT_POLICY=passive")
   if(NOT Python3_Interpreter_FOUND)
@@ -34,5 +38,9 @@ if(TARGET posidonia_flume)
              COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/examples/posidonia_flume/flow_map.py
                      ${SPHFSI_FLOW_MAP_DIR} --box 1.06,1.34,0.16 --check-balance 1e-6)
     set_tests_properties(posidonia.flow_map_balance PROPERTIES LABELS "regression" FIXTURES_REQUIRED sphfsi_flow_map)
+    add_test(NAME posidonia.flow_map_windows
+             COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/examples/posidonia_flume/flow_map.py
+                     ${SPHFSI_FLOW_MAP_DIR} --check-windows 1e-6)
+    set_tests_properties(posidonia.flow_map_windows PROPERTIES LABELS "regression" FIXTURES_REQUIRED sphfsi_flow_map)
   endif()
 endif()
