@@ -78,6 +78,11 @@ struct Options {
   // --uniform-viscosity on: alpha applies at the plants' smoothing length and scales as h_ref / h elsewhere, so the
   // coarse fluid has the fine fluid's viscosity (FluidParameters::viscosity_reference_smoothing_length).
   bool uniform_viscosity{false};
+  // --receding-viscosity on: the artificial viscosity on receding pairs too (FluidParameters::receding_pair_viscosity).
+  bool receding_viscosity{false};
+  // --fluid-shift on: particle shifting of every active fluid particle (fluid/particle_shifting.hpp); refined runs:
+  // of every level (AdaptiveRefinementParameters::shift_refined_only off).
+  bool fluid_shift{false};
   std::filesystem::path out;
   std::filesystem::path empty_from;  // reuse DIR/empty/wave_heights.csv of an earlier run instead of the empty run
   std::filesystem::path reference;   // the uniformly fine run to compare a refined run with (DIR/plants)
@@ -329,12 +334,13 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
       std::conditional_t<Drag, scenes::RodBlades<System, BladeDrag<T>>,
                          std::conditional_t<Rods, scenes::RodBlades<System>, CoupledBody<RepulsiveForce<T>, Solid>>>;
   using Adaptive = AdaptiveRefinement<System>;
+  using Shifting = ParticleShifting<System>;  // --fluid-shift (the refined flume shifts in its refinement model)
   using Solver = std::conditional_t<
       Refined,
       Simulation<System, std::conditional_t<Local, LocalSymplecticVerlet, SymplecticVerlet>, waves::DampingZone<T>,
                  Plant, Adaptive>,
-      std::conditional_t<WithPlants, Simulation<System, SymplecticVerlet, waves::DampingZone<T>, Plant>,
-                         Simulation<System, SymplecticVerlet, waves::DampingZone<T>>>>;
+      std::conditional_t<WithPlants, Simulation<System, SymplecticVerlet, waves::DampingZone<T>, Plant, Shifting>,
+                         Simulation<System, SymplecticVerlet, waves::DampingZone<T>, Shifting>>>;
   scenes::PosidoniaFlume<T> scene = converted<T>(o.scene);
   if (!WithPlants) scene.plants = 0;
   if (!Refined) scene.refinement.enabled = false;
@@ -348,18 +354,25 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
   fluid.thin_structure_guard = o.guard;
   fluid.same_resolution_pairs = Refined;  // adaptive refinement: each resolution sees only its own particles
   if (o.uniform_viscosity) fluid.viscosity_reference_smoothing_length = g.smoothing_ratio * scene.plant_dp();
+  fluid.receding_pair_viscosity = o.receding_viscosity;
+  ParticleShiftingParameters<T> shifting;  // --fluid-shift: every active fluid particle, after each step
+  shifting.enabled = o.fluid_shift;
+  shifting.coefficient = T(o.scene.refinement.shift_coefficient);
 
+  auto adaptive_parameters = scene.adaptive_refinement_parameters();
+  if (o.fluid_shift) adaptive_parameters.shifting.enabled = true, adaptive_parameters.shift_refined_only = false;
   TimeStepParameters<T> stepping;
   stepping.cfl = T(o.cfl);
   auto make_solver = [&]() {
     if constexpr (Refined) {
       return Solver(system, fluid, stepping, g.damping_zone(), scenes::add_posidonia_drag_blades(system, scene, layout),
-                    Adaptive(system.domain(), scene.refinement_boxes(), scene.adaptive_refinement_parameters()));
+                    Adaptive(system.domain(), scene.refinement_boxes(), adaptive_parameters));
     } else if constexpr (Drag) {
-      return Solver(system, fluid, stepping, g.damping_zone(),
-                    scenes::add_posidonia_drag_blades(system, scene, layout));
+      return Solver(system, fluid, stepping, g.damping_zone(), scenes::add_posidonia_drag_blades(system, scene, layout),
+                    Shifting(shifting));
     } else if constexpr (Rods) {
-      return Solver(system, fluid, stepping, g.damping_zone(), scenes::add_posidonia_rods(system, scene, layout));
+      return Solver(system, fluid, stepping, g.damping_zone(), scenes::add_posidonia_rods(system, scene, layout),
+                    Shifting(shifting));
     } else if constexpr (WithPlants) {
       typename Solid::Parameters params;
       params.gravity = Vec<2, T>(0, -g.wave.gravity);
@@ -370,9 +383,9 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
       RepulsiveForce<T> coupling;
       coupling.water_level = scene.depth;
       coupling.local_depth = scene.depth;
-      return Solver(system, fluid, stepping, g.damping_zone(), Plant(coupling, std::move(blades)));
+      return Solver(system, fluid, stepping, g.damping_zone(), Plant(coupling, std::move(blades)), Shifting(shifting));
     } else {
-      return Solver(system, fluid, stepping, g.damping_zone());
+      return Solver(system, fluid, stepping, g.damping_zone(), Shifting(shifting));
     }
   };
   Solver sim = make_solver();
@@ -1156,6 +1169,12 @@ int main(int argc, char** argv) try {
       "uniform-viscosity", false,
       "alpha at the plants' smoothing length, scaled as h_ref / h elsewhere (the same nu, proportional to alpha h c0, "
       "at both resolutions): on | off");
+  o.receding_viscosity = cli.get_switch(
+      "receding-viscosity", false,
+      "the artificial viscosity on receding pairs too (the delta-SPH viscous term; off: Monaghan's switch): on | off");
+  o.fluid_shift = cli.get_switch("fluid-shift", false,
+                                 "particle shifting of every active fluid particle, A = --shift-coefficient (refined "
+                                 "runs: of every level; --shift: the fine levels only): on | off");
   o.reference = cli.get("reference", "",
                         "with --refine on: compare with the uniformly fine run in DIR (H within 2 %, tip motion within "
                         "5 %, 2.5 times fewer particle-steps; exit 5 if not)");

@@ -5,6 +5,8 @@
 //   momentum       dv_a/dt   = -sum_b m_b (p_a/rho_a^2 + p_b/rho_b^2 + Pi_ab) grad + g        (Monaghan 1992, 3.3)
 //   art. viscosity Pi_ab = -alpha c_ab mu_ab / rho_ab,  mu_ab = h v_ab.x_ab / (r^2 + 0.01 h^2), v_ab.x_ab < 0
 //                                                                                            (Monaghan 1992, 4.1)
+//                  (FluidParameters::receding_pair_viscosity: every pair, the delta-SPH viscous term of Antuono et al.
+//                   2010)
 //                  with FluidParameters::viscosity_reference_smoothing_length h_ref > 0: alpha h_ref / h in place of
 //                  alpha (mu_ab with h_ref), so that nu ~ alpha h c0 is the same at every resolution of a scene
 //   laminar visc.  dv_a/dt += sum_b m_b nu (rho_a + rho_b)/(rho_a rho_b) x_ab.grad/(r^2 + eta^2) v_ab
@@ -98,6 +100,11 @@ struct FluidParameters {
   /// nu, proportional to alpha h c0, is the same at every resolution: coarse fluid no longer damps a wave twice as fast
   /// as the fine fluid it surrounds (docs/variable-resolution.md, session 20).
   T viscosity_reference_smoothing_length{T(0)};
+  /// Artificial viscosity on receding pairs too (v_ab.x_ab > 0), not only on approaching ones: the viscous term of
+  /// the delta-SPH scheme (Antuono, Colagrossi, Marrone & Molteni 2010, Comput. Phys. Commun. 181:532;
+  /// Marrone et al. 2011), a consistent viscous operator that damps shear whichever way a pair moves. false: Monaghan's
+  /// switch, which leaves the receding half of every shear flow undamped.
+  bool receding_pair_viscosity{false};
   T density_diffusion{T(0.1)};  ///< delta of delta-SPH, [0, 1] (0 switches it off)
   T xsph{T(0)};                 ///< epsilon of XSPH, [0, 1)
   T kinematic_viscosity{T(0)};  ///< laminar viscosity nu, m^2/s (0: none)
@@ -516,6 +523,7 @@ class WcsphFluid {
     const Vector g = params_.gravity;
     const T alpha = params_.artificial_viscosity;
     const T h_viscosity = params_.viscosity_reference_smoothing_length;  // 0: the pair's own h
+    const bool receding_viscosity = params_.receding_pair_viscosity;
     const T delta = params_.density_diffusion;
     const T eps_xsph = params_.xsph;
     const T nu = params_.kinematic_viscosity;
@@ -581,7 +589,9 @@ class WcsphFluid {
       const bool viscous_pair = (fluid_a && fluid_b) || params_.wall_artificial_viscosity;
       // Pi_ab with alpha h_ref / h in place of alpha when a reference smoothing length is set: the same nu everywhere
       const T mu_viscous = h_viscosity > T(0) ? h_viscosity * vr * inverse_distance2 : mu;
-      const T pi_ab = vr < T(0) && viscous_pair ? -alpha * (ca + c[b]) * mu_viscous / (rho_a + rho_b) : T(0);
+      const T pi_ab = (vr < T(0) || receding_viscosity) && viscous_pair
+                          ? -alpha * (ca + c[b]) * mu_viscous / (rho_a + rho_b)
+                          : T(0);
       const T pb = pressure_term[b];
       const T force = pa + pb + pi_ab;
       const T laminar =
