@@ -136,6 +136,18 @@ class ParticleShifting {
       gradient_[a] = gradient;
       surface_[a] = divergence < T(Dim) - params_.surface_deficit ? 1 : 0;
     });
+    // Which particles have a surface particle in their sums: with one smoothing length per pair's sums the relation
+    // is symmetric, so the (few) surface particles mark them, and only these need a neighbour loop in 2 (otherwise
+    // every particle loops).
+    near_surface_.assign(n, params_.same_resolution_only ? 0 : 1);
+    if (params_.same_resolution_only)
+      for (std::size_t s = 0; s < n; ++s) {
+        if (!surface_[s]) continue;
+        near_surface_[s] = 1;
+        system.for_each_neighbor(s, [&](std::size_t b, const Vector&, T r, T) {
+          if (counted(b, s, r)) near_surface_[b] = 1;
+        });
+      }
     // 2. The shifts. A particle at the surface or within the kernel support of one moves along the surface only:
     // the component along the surface normal (the kernel-weighted mean of the surface particles' grad C there) is
     // removed. (The rows below a surface have a full kernel sum, but grad C there points across the surface.)
@@ -146,11 +158,12 @@ class ParticleShifting {
       if (!(speed > T(0)) || fullness_[a] < params_.detached_fraction) return;
       bool surface = surface_[a] != 0;
       Vector normal = surface ? Vector(kernel.value(T(0), ha) * gradient_[a]) : Vector::Zero();
-      system.for_each_neighbor(a, [&](std::size_t b, const Vector&, T r, T) {
-        if (p.kind[b] != Kind::fluid || !surface_[b] || !counted(a, b, r)) return;
-        surface = true;
-        normal += kernel.value(r, ha) * gradient_[b];
-      });
+      if (near_surface_[a])
+        system.for_each_neighbor(a, [&](std::size_t b, const Vector&, T r, T) {
+          if (p.kind[b] != Kind::fluid || !surface_[b] || !counted(a, b, r)) return;
+          surface = true;
+          normal += kernel.value(r, ha) * gradient_[b];
+        });
       Vector dr = -params_.coefficient * ha * speed * dt * gradient_[a];
       std::uint8_t flag = 1;
       if (surface) {
@@ -183,10 +196,11 @@ class ParticleShifting {
   ParticleShiftingParameters<T> params_;
   ParticleShiftingCounts last_{};
   std::vector<Vector> shift_;
-  std::vector<Vector> gradient_;       // per slot: grad C
-  std::vector<T> fullness_;            // per slot: kernel sum
-  std::vector<std::uint8_t> surface_;  // per slot: divergence of position below Dim - surface_deficit
-  std::vector<std::uint8_t> flag_;     // per slot: 1 shifted, | 2 along the surface only, | 4 capped
+  std::vector<Vector> gradient_;            // per slot: grad C
+  std::vector<T> fullness_;                 // per slot: kernel sum
+  std::vector<std::uint8_t> surface_;       // per slot: divergence of position below Dim - surface_deficit
+  std::vector<std::uint8_t> near_surface_;  // per slot: a surface particle in its sums
+  std::vector<std::uint8_t> flag_;          // per slot: 1 shifted, | 2 along the surface only, | 4 capped
 };
 
 }  // namespace sphfsi
