@@ -360,7 +360,10 @@ CaseResult run_case(const Options& o, const std::filesystem::path& dir) {
   shifting.coefficient = T(o.scene.refinement.shift_coefficient);
 
   auto adaptive_parameters = scene.adaptive_refinement_parameters();
-  if (o.fluid_shift) adaptive_parameters.shifting.enabled = true, adaptive_parameters.shift_refined_only = false;
+  if (o.fluid_shift) {
+    adaptive_parameters.shifting.enabled = true;
+    adaptive_parameters.shift_refined_only = false;
+  }
   TimeStepParameters<T> stepping;
   stepping.cfl = T(o.cfl);
   auto make_solver = [&]() {
@@ -1188,6 +1191,11 @@ int main(int argc, char** argv) try {
   if (precision == "auto") precision = s.thin_blade() ? "double" : "float";
   if (o.visibility && s.blade == scenes::BladeModel::drag)
     throw InputError("--visibility on: only for --blade rod (the porous drag blades let the water through)");
+  // the shift's concentration leaves solid particles out, so it would push the water into a continuum blade
+  if (o.fluid_shift && (s.blade == scenes::BladeModel::scaled || s.blade == scenes::BladeModel::equivalent))
+    throw InputError(
+        "--fluid-shift on: only for --blade rod or drag (a continuum blade's particles are not in the "
+        "shift's particle concentration)");
   if (runs != "both" && runs != "plants" && runs != "empty")
     throw InputError(fmt::format("--runs '{}': valid are both, plants, empty", runs));
   o.run_plants = runs != "empty" && !no_plants && s.plants > 0;
